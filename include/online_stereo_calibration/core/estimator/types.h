@@ -1,0 +1,37 @@
+/// @file types.h
+/// @brief Plain data exchanged between the front ends (image pipeline, simulators, ROS
+/// adapter) and the estimator. No ROS, no OpenCV.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace osc {
+
+/// Identifies one tracked static point for as long as it is tracked.
+using PointId = std::uint64_t;
+
+/// Measured vehicle motion between two consecutive image pairs.
+struct MotionIncrement {
+  /// T_{veh(k-1)}_{veh(k)}: pose of the vehicle at the current image pair expressed in the
+  /// vehicle frame at the previous one (the inverse of the paper's H^veh_veh(k+1|k)).
+  Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();
+  /// Time between the two image pairs (s); > 0.
+  double dt = 0.1;
+};
+
+/// One point seen in both images of a stereo pair.
+struct StereoObservation {
+  PointId id = 0;
+  Eigen::Vector2d left_pixel = Eigen::Vector2d::Zero();   ///< raw (distorted) pixel, left image
+  Eigen::Vector2d right_pixel = Eigen::Vector2d::Zero();  ///< raw (distorted) pixel, right image
+  /// Pixel standard deviation of this measurement in each image; <= 0 means "use the
+  /// configured pixel_noise".
+  double sigma_left = 0.0;
+  double sigma_right = 0.0;
+};
+
+}  // namespace osc
