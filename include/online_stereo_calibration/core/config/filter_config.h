@@ -1,0 +1,107 @@
+/// @file filter_config.h
+/// @brief Every tunable of the estimator in one struct, with one table that names each
+/// parameter, its unit, its allowed range and its meaning. The YAML loader, the ROS
+/// parameter loader and validate() all read that table, so a name exists once.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace osc {
+
+/// How the error of the measured vehicle motion enters the prediction of the points.
+enum class MotionNoiseModel {
+  /// Seed eq. 15-27: an independent 3x3 noise per point. Treats one common motion error as
+  /// N independent ones, which lets N points average it away: overconfident.
+  kPerPoint,
+  /// Ours: the motion error of a step is one 6-DoF random variable shared by all points,
+  /// estimated jointly with the calibration during the step and then marginalised.
+  kShared,
+};
+
+/// The estimator's configuration. Internal units are SI (m, rad, s, px); the parameter
+/// table converts from the file units named in each key (e.g. `_deg`).
+struct FilterConfig {
+  // --- scaled unscented transform (Julier 2002), used for every nonlinear step ---
+  double ut_alpha = 0.5;  ///< spread of the sigma points
+  double ut_beta = 2.0;   ///< prior knowledge of the distribution (2 = Gaussian)
+  double ut_kappa = 0.0;  ///< secondary scaling
+
+  /// The step length (s) to which the per-step noise sigmas below refer (paper: 10 Hz).
+  /// Variances scale with dt / reference_period.
+  double reference_period = 0.1;
+
+  // --- calibration drift per reference step, seed eq. 10-13 ---
+  double caml_translation_drift = 0.05e-3;           ///< m
+  double caml_rotation_drift = 0.005 * 0.0174532925199432958;   ///< rad
+  double camr_translation_drift = 0.01e-3;           ///< m
+  double camr_rotation_drift = 0.0005 * 0.0174532925199432958;  ///< rad
+
+  // --- points, seed eq. 14-27 ---
+  /// sigma_p of eq. 14 per step (m). The paper's 0.2 m makes every point forget its
+  /// position each step; points are static, so ours only covers model error.
+  double point_position_noise = 0.002;
+  MotionNoiseModel motion_noise_model = MotionNoiseModel::kShared;
+  double motion_rotation_noise = 0.02 * 0.0174532925199432958;  ///< rad per axis per step (eq. 15)
+  double motion_translation_noise = 0.002;  ///< m per axis per step (shared model only)
+
+  // --- measurements, seed eq. 29-30 ---
+  double pixel_noise = 0.5;       ///< px, default sigma of a feature position
+  double outlier_gate = 18.47;    ///< chi-square(4) of a stereo innovation; 18.47 = 99.9 %
+
+  // --- initial uncertainty of the guess (1 sigma) ---
+  double initial_caml_translation_sigma = 0.5;  ///< m
+  double initial_caml_rotation_sigma = 10.0 * 0.0174532925199432958;  ///< rad
+  double initial_camr_translation_sigma = 0.1;  ///< m
+  double initial_camr_rotation_sigma = 2.0 * 0.0174532925199432958;   ///< rad
+
+  // --- new points (Sec. II-A) ---
+  double min_point_depth = 1.0;   ///< m
+  double max_point_depth = 80.0;  ///< m
+  int max_points = 150;           ///< points kept in the state
+
+  // --- input sanity ---
+  double max_speed = 70.0;           ///< m/s; a motion increment faster than this is rejected
+  double max_angular_rate = 3.0;     ///< rad/s; likewise
+  double max_frame_interval = 1.0;   ///< s; a longer gap between image pairs is rejected
+
+  // --- sudden calibration change (a knock, seed Sec. III frame 774) ---
+  double jump_rejected_fraction = 0.6;  ///< fraction of gated-out points that signals a jump
+  int jump_min_points = 8;              ///< ... when at least this many points were tested
+  double jump_rotation_sigma = 10.0 * 0.0174532925199432958;  ///< rad, re-opened 1 sigma
+  double jump_translation_sigma = 0.02;  ///< m, re-opened 1 sigma
+
+  /// Every problem found, each naming the parameter, its value and the allowed range.
+  std::vector<std::string> validate() const;
+};
+
+/// One row of the parameter table.
+struct ParameterSpec {
+  std::string name;  ///< key in YAML / on the ROS parameter server, with its unit suffix
+  std::string doc;   ///< one line for humans
+  double file_to_internal = 1.0;  ///< e.g. pi/180 for `_deg` keys
+  double min_value = 0.0;         ///< allowed range in file units, inclusive
+  double max_value = 0.0;
+  bool is_integer = false;
+  double FilterConfig::*real_field = nullptr;
+  int FilterConfig::*integer_field = nullptr;
+
+  /// Value in file units.
+  double get(const FilterConfig& config) const;
+  /// Sets from file units (no range check; validate() does that).
+  void set(FilterConfig* config, double file_value) const;
+};
+
+/// The table: every numeric parameter of FilterConfig (motion_noise_model is the one
+/// non-numeric key, see motionNoiseModelFromName).
+const std::vector<ParameterSpec>& filterParameterTable();
+
+/// "per_point" | "shared"; @throws std::invalid_argument naming the allowed values.
+MotionNoiseModel motionNoiseModelFromName(const std::string& name);
+std::string motionNoiseModelName(MotionNoiseModel model);
+
+/// The seed paper's values (config/paper.yaml holds the same): sigma_p = 0.2 m and the
+/// per-point motion noise of eq. 15-27.
+FilterConfig paperFilterConfig();
+
+}  // namespace osc

@@ -1,0 +1,126 @@
+/// @file calibration_filter.h
+/// @brief The paper's UKF over [x_caml, x_camr, points] (seed eq. 4), in a structured
+/// form whose cost grows linearly with the number of points.
+///
+/// Structure exploited: each point's prediction depends only on x_caml, the motion and
+/// itself; each measurement only on x_camr and itself. Given the calibration g, the
+/// points' errors are then independent, so the joint Gaussian is held exactly as
+///   p_i = p_hat_i + B_i * dg + e_i,   e_i ~ N(0, D_i) independent,  dg ~ N(0, P),
+/// i.e. Cov(p_i, g) = B_i P and Cov(p_i, p_j) = B_i P B_j^T + [i == j] D_i.
+/// Each nonlinear step is a scaled unscented transform on one point's small joint state
+/// (at most 15 dimensions), whose statistical linear regression is applied to this form;
+/// the calibration update is the exact Kalman update of all points' measurements with the
+/// points marginalised. Memory and time O(N) instead of O(N^2) / O(N^3).
+#pragma once
+
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "online_stereo_calibration/core/config/filter_config.h"
+#include "online_stereo_calibration/core/estimator/types.h"
+#include "online_stereo_calibration/core/filter/measurement_model.h"
+#include "online_stereo_calibration/core/filter/unscented_transform.h"
+#include "online_stereo_calibration/core/geometry/pose.h"
+
+namespace osc {
+
+/// One stereo measurement of a tracked point in undistorted pixels (measurement_model.h).
+struct PointMeasurement {
+  PointId id = 0;
+  Eigen::Vector4d z = Eigen::Vector4d::Zero();  ///< [u_l, v_l, u_r, v_r]
+  Eigen::Vector4d variance = Eigen::Vector4d::Ones();  ///< px^2 per coordinate
+};
+
+/// The filter's estimate of one tracked point.
+struct PointEstimate {
+  PointId id = 0;
+  Eigen::Vector3d position_lopt = Eigen::Vector3d::Zero();  ///< left optical frame (m)
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();     ///< marginal covariance
+};
+
+/// Which calibration block a detected sudden change was attributed to.
+enum class JumpBlock { kNone, kVehicleToLeft, kLeftToRight };
+
+/// What one filter step did.
+struct StepReport {
+  bool accepted = false;        ///< false: the input was rejected and nothing changed
+  std::string message;          ///< why it was rejected, or notes
+  int measurements_used = 0;    ///< points that updated the filter
+  int invalid_measurements = 0; ///< non-finite or non-positive-variance measurements ignored
+  std::vector<PointId> outliers;  ///< gated out (Mahalanobis) and removed
+  std::vector<PointId> lost;      ///< not measured (or unpredictable) and removed
+  JumpBlock jump = JumpBlock::kNone;  ///< a sudden calibration change was detected
+  bool covariance_repaired = false;   ///< the calibration covariance had to be made PD
+  double mean_nis = 0.0;        ///< mean normalised innovation squared of used points (4 dof)
+};
+
+/// Structured UKF for the stereo extrinsics and the tracked points.
+class CalibrationFilter {
+ public:
+  /// @throws std::invalid_argument listing every invalid config value.
+  CalibrationFilter(const FilterConfig& config, const StereoIntrinsics& intrinsics);
+
+  /// Starts over from a guess with the config's initial sigmas; removes every point.
+  void reset(const StereoExtrinsics& guess);
+  /// Starts over from a guess with the given tangent covariance (see covariance()).
+  /// @throws std::invalid_argument if the covariance is not finite, symmetric PD.
+  void reset(const StereoExtrinsics& guess, const Matrix12d& covariance);
+
+  /// Predicts with the measured motion (eq. 7-28) and corrects with the measurements
+  /// (eq. 29-30). Tracked points without a measurement are removed (Sec. II-C), and so
+  /// are outliers. A rejected motion leaves the filter untouched (report.accepted false).
+  StepReport step(const MotionIncrement& motion, const std::vector<PointMeasurement>& measurements);
+
+  /// Triangulates a new point with a scaled UT over x_camr and both pixels' noise and
+  /// adds it with its covariance and its cross-covariance with the calibration (Sec. II-A).
+  /// False (and nothing added) if the rays do not meet within the depth range.
+  bool addPoint(const PointMeasurement& measurement);
+  void removePoint(PointId id);
+  bool hasPoint(PointId id) const { return index_.count(id) > 0; }
+  size_t pointCount() const { return points_.size(); }
+
+  const StereoExtrinsics& extrinsics() const { return extrinsics_; }
+  /// Covariance of the tangent error [dt_l, dtheta_l, dt_r, dtheta_r] (pose.h boxPlus).
+  const Matrix12d& covariance() const { return covariance_; }
+  /// Covariance of the interface's 12 parameters (RPY), by first-order propagation.
+  Matrix12d parameterCovariance() const;
+  std::vector<PointEstimate> points() const;
+  /// The full (12 + 3N)^2 covariance the structured form represents, points in the order
+  /// of points(). For tests and diagnostics; O(N^2).
+  Eigen::MatrixXd denseCovariance() const;
+
+  const FilterConfig& config() const { return config_; }
+  const StereoIntrinsics& intrinsics() const { return intrinsics_; }
+
+ private:
+  struct TrackedPoint {
+    PointId id = 0;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    Eigen::MatrixXd B;  ///< 3 x G regression on the global error
+    Eigen::Matrix3d D = Eigen::Matrix3d::Zero();
+  };
+  struct PointInnovation;  // defined in the .cpp
+
+  std::string checkMotion(const MotionIncrement& motion) const;
+  void applyCalibrationDrift(double dt);
+  void predictPoints(const MotionIncrement& motion, const Eigen::MatrixXd& P_global,
+                     std::vector<bool>* failed);
+  void marginalizeMotionError(const Eigen::MatrixXd& P_global);
+  void reopenBlock(JumpBlock block);
+  void removeIndices(const std::vector<bool>& remove);
+  bool repairCovariance();
+  void rebuildIndex();
+
+  FilterConfig config_;
+  UnscentedParameters ut_;
+  StereoIntrinsics intrinsics_;
+  StereoExtrinsics extrinsics_;
+  Matrix12d covariance_ = Matrix12d::Identity();
+  std::vector<TrackedPoint> points_;
+  std::unordered_map<PointId, size_t> index_;
+};
+
+}  // namespace osc

@@ -1,0 +1,40 @@
+/// @file scenario_runner.h
+/// @brief Runs the estimator over a measurement-level scenario, frame by frame, the way a
+/// front end would: observations in, dropped tracks fed back to the simulated tracker.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "online_stereo_calibration/core/config/filter_config.h"
+#include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
+#include "online_stereo_calibration/core/sim/measurement_scenario.h"
+
+namespace osc {
+
+/// One frame of a scenario run: estimate, its uncertainty and the truth.
+struct ScenarioFrameResult {
+  int frame = 0;
+  double stamp = 0.0;
+  Vector12d parameters = Vector12d::Zero();  ///< estimate, interface order
+  Vector12d sigmas = Vector12d::Zero();      ///< 1 sigma of parameters
+  Vector12d truth = Vector12d::Zero();       ///< true parameters
+  /// Error on the manifold [dt_l, dtheta_l, dt_r, dtheta_r] (truth boxMinus estimate),
+  /// meaningful for any mounting, also where RPY is singular.
+  Vector12d tangent_error = Vector12d::Zero();
+  Vector12d tangent_sigmas = Vector12d::Zero();  ///< 1 sigma of the tangent error
+  double nees = 0.0;        ///< tangent_error^T P^-1 tangent_error (12 dof)
+  int tracked_points = 0;
+  int new_points = 0;
+  bool jump_detected = false;
+  double time_ms = 0.0;     ///< estimator time for this frame
+};
+
+/// Runs scenario through a StereoCalibrationEstimator starting from the scenario's initial
+/// guess; calls on_frame after each frame if given.
+/// @throws std::invalid_argument for an invalid scenario or config.
+std::vector<ScenarioFrameResult> runMeasurementScenario(
+    const MeasurementScenario& scenario, const FilterConfig& config,
+    const std::function<void(const ScenarioFrameResult&)>& on_frame = {});
+
+}  // namespace osc

@@ -1,0 +1,146 @@
+#include "online_stereo_calibration/core/config/filter_config.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace osc {
+namespace {
+
+constexpr double kDeg = 0.0174532925199432958;
+
+ParameterSpec real(const char* name, double FilterConfig::*field, double scale, double lo,
+                   double hi, const char* doc) {
+  ParameterSpec s;
+  s.name = name;
+  s.doc = doc;
+  s.file_to_internal = scale;
+  s.min_value = lo;
+  s.max_value = hi;
+  s.real_field = field;
+  return s;
+}
+
+ParameterSpec integer(const char* name, int FilterConfig::*field, int lo, int hi, const char* doc) {
+  ParameterSpec s;
+  s.name = name;
+  s.doc = doc;
+  s.min_value = lo;
+  s.max_value = hi;
+  s.is_integer = true;
+  s.integer_field = field;
+  return s;
+}
+
+}  // namespace
+
+double ParameterSpec::get(const FilterConfig& config) const {
+  if (is_integer) return static_cast<double>(config.*integer_field);
+  return config.*real_field / file_to_internal;
+}
+
+void ParameterSpec::set(FilterConfig* config, double file_value) const {
+  if (is_integer) {
+    config->*integer_field = static_cast<int>(std::lround(file_value));
+  } else {
+    config->*real_field = file_value * file_to_internal;
+  }
+}
+
+const std::vector<ParameterSpec>& filterParameterTable() {
+  using C = FilterConfig;
+  static const std::vector<ParameterSpec> table = {
+      real("ut_alpha", &C::ut_alpha, 1.0, 1e-3, 1.0, "scaled unscented transform: sigma-point spread"),
+      real("ut_beta", &C::ut_beta, 1.0, 0.0, 10.0, "scaled unscented transform: 2 for Gaussian priors"),
+      real("ut_kappa", &C::ut_kappa, 1.0, 0.0, 10.0, "scaled unscented transform: secondary scaling"),
+      real("reference_period_s", &C::reference_period, 1.0, 1e-3, 10.0,
+           "step length the per-step noise sigmas refer to (paper: 0.1 s at 10 Hz)"),
+      real("caml_translation_drift_m", &C::caml_translation_drift, 1.0, 0.0, 1.0,
+           "vehicle->left translation random walk per step (eq. 10)"),
+      real("caml_rotation_drift_deg", &C::caml_rotation_drift, kDeg, 0.0, 10.0,
+           "vehicle->left rotation random walk per step (eq. 11)"),
+      real("camr_translation_drift_m", &C::camr_translation_drift, 1.0, 0.0, 1.0,
+           "left->right translation random walk per step (eq. 12)"),
+      real("camr_rotation_drift_deg", &C::camr_rotation_drift, kDeg, 0.0, 10.0,
+           "left->right rotation random walk per step (eq. 13)"),
+      real("point_position_noise_m", &C::point_position_noise, 1.0, 0.0, 10.0,
+           "sigma_p: point position noise per step (eq. 14)"),
+      real("motion_rotation_noise_deg", &C::motion_rotation_noise, kDeg, 0.0, 10.0,
+           "sigma_IMU: error of the measured vehicle rotation per axis per step (eq. 15)"),
+      real("motion_translation_noise_m", &C::motion_translation_noise, 1.0, 0.0, 10.0,
+           "error of the measured vehicle translation per axis per step (shared model)"),
+      real("pixel_noise_px", &C::pixel_noise, 1.0, 1e-3, 100.0,
+           "default standard deviation of a feature position"),
+      real("outlier_gate", &C::outlier_gate, 1.0, 1.0, 1e6,
+           "chi-square(4) bound on a point's stereo innovation; beyond it the point is an outlier"),
+      real("initial_caml_translation_sigma_m", &C::initial_caml_translation_sigma, 1.0, 1e-6, 100.0,
+           "1 sigma of the initial guess, vehicle->left translation"),
+      real("initial_caml_rotation_sigma_deg", &C::initial_caml_rotation_sigma, kDeg, 1e-6, 90.0,
+           "1 sigma of the initial guess, vehicle->left rotation"),
+      real("initial_camr_translation_sigma_m", &C::initial_camr_translation_sigma, 1.0, 1e-6, 10.0,
+           "1 sigma of the initial guess, left->right translation"),
+      real("initial_camr_rotation_sigma_deg", &C::initial_camr_rotation_sigma, kDeg, 1e-6, 90.0,
+           "1 sigma of the initial guess, left->right rotation"),
+      real("min_point_depth_m", &C::min_point_depth, 1.0, 0.01, 1e4,
+           "new points closer than this are not added"),
+      real("max_point_depth_m", &C::max_point_depth, 1.0, 0.01, 1e5,
+           "new points farther than this are not added"),
+      integer("max_points", &C::max_points, 1, 100000, "points kept in the filter state"),
+      real("max_speed_mps", &C::max_speed, 1.0, 0.0, 1e4,
+           "a motion increment faster than this is rejected as corrupt"),
+      real("max_angular_rate_dps", &C::max_angular_rate, kDeg, 0.0, 1e5,
+           "a motion increment turning faster than this is rejected as corrupt"),
+      real("max_frame_interval_s", &C::max_frame_interval, 1.0, 1e-3, 1e4,
+           "a longer gap between image pairs is rejected (motion unusable)"),
+      real("jump_rejected_fraction", &C::jump_rejected_fraction, 1.0, 0.0, 1.0,
+           "fraction of gated-out points that signals a sudden calibration change"),
+      integer("jump_min_points", &C::jump_min_points, 1, 100000,
+              "least number of tested points for the jump test"),
+      real("jump_rotation_sigma_deg", &C::jump_rotation_sigma, kDeg, 0.0, 90.0,
+           "rotation 1 sigma re-opened after a detected jump"),
+      real("jump_translation_sigma_m", &C::jump_translation_sigma, 1.0, 0.0, 10.0,
+           "translation 1 sigma re-opened after a detected jump"),
+  };
+  return table;
+}
+
+std::vector<std::string> FilterConfig::validate() const {
+  std::vector<std::string> problems;
+  for (const ParameterSpec& spec : filterParameterTable()) {
+    const double value = spec.get(*this);
+    if (!std::isfinite(value) || value < spec.min_value || value > spec.max_value) {
+      std::ostringstream message;
+      message << spec.name << " = " << value << " is outside the allowed range [" << spec.min_value
+              << ", " << spec.max_value << "] (" << spec.doc << ")";
+      problems.push_back(message.str());
+    }
+  }
+  if (min_point_depth >= max_point_depth) {
+    std::ostringstream message;
+    message << "min_point_depth_m = " << min_point_depth << " must be below max_point_depth_m = "
+            << max_point_depth;
+    problems.push_back(message.str());
+  }
+  return problems;
+}
+
+MotionNoiseModel motionNoiseModelFromName(const std::string& name) {
+  if (name == "per_point") return MotionNoiseModel::kPerPoint;
+  if (name == "shared") return MotionNoiseModel::kShared;
+  throw std::invalid_argument("motion_noise_model = '" + name +
+                              "' is not one of: per_point (paper eq. 15-27), shared");
+}
+
+std::string motionNoiseModelName(MotionNoiseModel model) {
+  return model == MotionNoiseModel::kPerPoint ? "per_point" : "shared";
+}
+
+FilterConfig paperFilterConfig() {
+  FilterConfig config;
+  config.point_position_noise = 0.2;  // eq. 14
+  config.motion_noise_model = MotionNoiseModel::kPerPoint;
+  config.motion_translation_noise = 0.0;  // "not considered in this paper"
+  return config;
+}
+
+}  // namespace osc

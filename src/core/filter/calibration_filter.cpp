@@ -1,0 +1,470 @@
+#include "online_stereo_calibration/core/filter/calibration_filter.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include "online_stereo_calibration/core/filter/process_model.h"
+#include "online_stereo_calibration/core/filter/state_layout.h"
+#include "online_stereo_calibration/core/geometry/rotation.h"
+
+namespace osc {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+
+/// chi-square(2) at 99.9 %: the left image's share of a stereo innovation.
+constexpr double kLeftGate = 13.82;
+
+Matrix12d initialCovariance(const FilterConfig& c) {
+  using namespace layout;
+  Vector12d sigma;
+  sigma.segment<3>(kCaml + kTranslation).setConstant(c.initial_caml_translation_sigma);
+  sigma.segment<3>(kCaml + kRotation).setConstant(c.initial_caml_rotation_sigma);
+  sigma.segment<3>(kCamr + kTranslation).setConstant(c.initial_camr_translation_sigma);
+  sigma.segment<3>(kCamr + kRotation).setConstant(c.initial_camr_rotation_sigma);
+  return sigma.array().square().matrix().asDiagonal();
+}
+
+Eigen::Isometry3d leftToRightOptical(const Eigen::Isometry3d& T_caml_camr) {
+  StereoExtrinsics e;
+  e.T_caml_camr = T_caml_camr;
+  return e.leftToRightOptical();
+}
+
+/// Joint covariance of [g(selected), p] for a point p = mean + B dg + e.
+MatrixXd jointCovariance(const MatrixXd& P, const std::vector<int>& selected, const MatrixXd& B,
+                         const Eigen::Matrix3d& D) {
+  const int s = static_cast<int>(selected.size());
+  MatrixXd C(s + 3, s + 3);
+  const MatrixXd BP = B * P;  // Cov(p, g)
+  for (int a = 0; a < s; ++a) {
+    for (int b = 0; b < s; ++b) C(a, b) = P(selected[a], selected[b]);
+    C.block<3, 1>(s, a) = BP.col(selected[a]);
+    C.block<1, 3>(a, s) = BP.col(selected[a]).transpose();
+  }
+  C.block<3, 3>(s, s) = BP * B.transpose() + D;
+  return C;
+}
+
+std::vector<int> range(int first, int count) {
+  std::vector<int> r(count);
+  for (int k = 0; k < count; ++k) r[k] = first + k;
+  return r;
+}
+
+}  // namespace
+
+/// A point's linearised measurement (regression of the UT on [x_camr, p]).
+struct CalibrationFilter::PointInnovation {
+  size_t point = 0;
+  Eigen::Vector4d residual;
+  MatrixXd J;             ///< 4 x G: d residual / d global error (through x_camr and B)
+  Eigen::Matrix<double, 4, 3> H_p;  ///< d z / d point
+  Eigen::Matrix4d S0;     ///< covariance of the residual given the global error
+  double nis = 0.0;       ///< full normalised innovation squared
+  double nis_left = 0.0;  ///< left image only
+};
+
+CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoIntrinsics& intrinsics)
+    : config_(config), intrinsics_(intrinsics) {
+  const std::vector<std::string> problems = config.validate();
+  if (!problems.empty()) {
+    std::string message = "invalid filter configuration:";
+    for (const auto& p : problems) message += "\n  " + p;
+    throw std::invalid_argument(message);
+  }
+  if (!intrinsics.K_left.allFinite() || !intrinsics.K_right.allFinite() ||
+      !(intrinsics.K_left(0, 0) > 0) || !(intrinsics.K_right(0, 0) > 0)) {
+    throw std::invalid_argument("camera matrices K_left/K_right must be finite with positive focal length");
+  }
+  ut_.alpha = config.ut_alpha;
+  ut_.beta = config.ut_beta;
+  ut_.kappa = config.ut_kappa;
+  reset(StereoExtrinsics());
+}
+
+void CalibrationFilter::reset(const StereoExtrinsics& guess) { reset(guess, initialCovariance(config_)); }
+
+void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& covariance) {
+  if (!covariance.allFinite() || (covariance - covariance.transpose()).cwiseAbs().maxCoeff() >
+                                     1e-9 * covariance.cwiseAbs().maxCoeff() ||
+      covariance.llt().info() != Eigen::Success) {
+    throw std::invalid_argument("initial calibration covariance must be finite, symmetric and positive definite");
+  }
+  extrinsics_ = guess;
+  covariance_ = covariance;
+  points_.clear();
+  index_.clear();
+}
+
+std::string CalibrationFilter::checkMotion(const MotionIncrement& m) const {
+  std::ostringstream why;
+  const Eigen::Matrix3d R = m.T_prev_curr.linear();
+  if (!std::isfinite(m.dt) || !(m.dt > 0.0)) {
+    why << "motion dt = " << m.dt << " s is not a positive number";
+  } else if (m.dt > config_.max_frame_interval) {
+    why << "motion dt = " << m.dt << " s exceeds max_frame_interval_s = " << config_.max_frame_interval;
+  } else if (!m.T_prev_curr.matrix().allFinite()) {
+    why << "motion increment contains NaN or Inf";
+  } else if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
+             R.determinant() < 0.0) {
+    why << "motion rotation is not a rotation matrix";
+  } else if (m.T_prev_curr.translation().norm() > config_.max_speed * m.dt) {
+    why << "motion of " << m.T_prev_curr.translation().norm() << " m in " << m.dt
+        << " s exceeds max_speed_mps = " << config_.max_speed;
+  } else if (logSO3(R).norm() > config_.max_angular_rate * m.dt) {
+    why << "rotation of " << logSO3(R).norm() * 180.0 / M_PI << " deg in " << m.dt
+        << " s exceeds max_angular_rate_dps = " << config_.max_angular_rate * 180.0 / M_PI;
+  }
+  return why.str();
+}
+
+void CalibrationFilter::applyCalibrationDrift(double dt) {
+  // g' = g + w (eq. 10-13). Each point is re-regressed on g' so that its marginal and its
+  // cross-covariance with g' stay exact: B' = B P P'^-1, D' = D + B (P - P P'^-1 P) B^T.
+  const Matrix12d P_next = covariance_ + calibrationDriftCovariance(config_, dt);
+  const Matrix12d M = P_next.llt().solve(covariance_).transpose();  // P P'^-1
+  const Matrix12d forgotten = covariance_ - M * covariance_;
+  for (TrackedPoint& point : points_) {
+    point.D += point.B * forgotten * point.B.transpose();
+    point.B = point.B * M;
+  }
+  covariance_ = P_next;
+}
+
+void CalibrationFilter::predictPoints(const MotionIncrement& motion, const MatrixXd& P,
+                                      std::vector<bool>* failed) {
+  // Seed eq. 7-8 through a UT on [x_caml, (motion error), p] per point (eq. 28).
+  const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
+  std::vector<int> selected = range(layout::kCaml, layout::kPoseDim);
+  if (shared) {
+    const std::vector<int> motion_block = range(layout::kMotion, layout::kPoseDim);
+    selected.insert(selected.end(), motion_block.begin(), motion_block.end());
+  }
+  const int s = static_cast<int>(selected.size());
+  const double sigma_p2 = config_.point_position_noise * config_.point_position_noise *
+                          noiseScale(config_, motion.dt);
+  const double sigma_imu = config_.motion_rotation_noise * std::sqrt(noiseScale(config_, motion.dt));
+
+  for (size_t i = 0; i < points_.size(); ++i) {
+    TrackedPoint& point = points_[i];
+    const Eigen::Vector3d mean = point.mean;
+    const VectorFunction predict = [&](const VectorXd& x, VectorXd* y) {
+      const Eigen::Isometry3d T_veh_lopt =
+          boxPlus(extrinsics_.T_veh_caml, x.head<6>()) * bodyFromOptical();
+      const Eigen::Isometry3d T_prev_curr =
+          shared ? boxPlus(motion.T_prev_curr, x.segment<6>(6)) : motion.T_prev_curr;
+      *y = predictPoint(mean + x.tail<3>(), T_veh_lopt, T_prev_curr);
+      return true;
+    };
+    UnscentedResult ut;
+    if (!unscentedTransform(VectorXd::Zero(s + 3), jointCovariance(P, selected, point.B, point.D),
+                            predict, ut_, &ut)) {
+      (*failed)[i] = true;
+      continue;
+    }
+    const Eigen::Matrix3d F_p = ut.jacobian.rightCols<3>();
+    MatrixXd B = F_p * point.B;
+    for (int a = 0; a < s; ++a) B.col(selected[a]) += ut.jacobian.col(a);
+    Eigen::Matrix3d Q = sigma_p2 * Eigen::Matrix3d::Identity();
+    if (!shared) Q = paperPointProcessNoise(mean, sigma_imu, config_.point_position_noise * std::sqrt(noiseScale(config_, motion.dt)));
+    point.D = F_p * point.D * F_p.transpose() + ut.residual + Q;
+    point.D = 0.5 * (point.D + point.D.transpose());
+    point.B = B;
+    point.mean = ut.mean;
+  }
+}
+
+StepReport CalibrationFilter::step(const MotionIncrement& motion,
+                                   const std::vector<PointMeasurement>& measurements) {
+  StepReport report;
+  report.message = checkMotion(motion);
+  if (!report.message.empty()) return report;  // untouched
+  report.accepted = true;
+
+  // ---- prediction (Sec. II-B) ----
+  applyCalibrationDrift(motion.dt);
+  const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
+  const int G = shared ? layout::kAugmentedDim : layout::kCalibrationDim;
+  MatrixXd P = MatrixXd::Zero(G, G);
+  P.topLeftCorner<12, 12>() = covariance_;
+  if (shared) {
+    P.bottomRightCorner<6, 6>() = motionNoiseCovariance(config_, motion.dt);
+    for (TrackedPoint& point : points_) {
+      point.B.conservativeResize(3, G);
+      point.B.rightCols<6>().setZero();
+    }
+  }
+  std::vector<bool> remove(points_.size(), false);
+  predictPoints(motion, P, &remove);
+
+  // ---- linearised measurements of every measured point (Sec. II-C) ----
+  std::vector<PointInnovation> innovations;
+  std::vector<bool> measured(points_.size(), false);
+  const std::vector<int> camr = range(layout::kCamr, layout::kPoseDim);
+  for (const PointMeasurement& m : measurements) {
+    if (!m.z.allFinite() || !m.variance.allFinite() || !(m.variance.minCoeff() > 0.0)) {
+      ++report.invalid_measurements;
+      continue;
+    }
+    const auto found = index_.find(m.id);
+    if (found == index_.end() || remove[found->second]) continue;
+    const size_t i = found->second;
+    TrackedPoint& point = points_[i];
+    const VectorFunction observe = [&](const VectorXd& x, VectorXd* y) {
+      const Eigen::Isometry3d T_ropt_lopt =
+          leftToRightOptical(boxPlus(extrinsics_.T_caml_camr, x.head<6>())).inverse();
+      Eigen::Vector4d z;
+      if (!projectStereo(point.mean + x.tail<3>(), T_ropt_lopt, intrinsics_, 1e-3, &z)) return false;
+      *y = z;
+      return true;
+    };
+    UnscentedResult ut;
+    if (!unscentedTransform(VectorXd::Zero(9), jointCovariance(P, camr, point.B, point.D), observe,
+                            ut_, &ut)) {
+      continue;  // behind a camera for some sigma point: not measurable, dropped below
+    }
+    measured[i] = true;
+    PointInnovation inn;
+    inn.point = i;
+    inn.residual = m.z - ut.mean;
+    inn.H_p = ut.jacobian.rightCols<3>();
+    inn.J = inn.H_p * point.B;
+    for (int a = 0; a < 6; ++a) inn.J.col(camr[a]) += ut.jacobian.col(a);
+    inn.S0 = inn.H_p * point.D * inn.H_p.transpose() + ut.residual;
+    inn.S0.diagonal() += m.variance;
+    const Eigen::Matrix4d S = inn.J * P * inn.J.transpose() + inn.S0;
+    inn.nis = inn.residual.dot(S.llt().solve(inn.residual));
+    inn.nis_left = inn.residual.head<2>().dot(S.topLeftCorner<2, 2>().llt().solve(inn.residual.head<2>()));
+    innovations.push_back(inn);
+  }
+
+  // ---- gate outliers; many at once means the calibration itself jumped ----
+  std::vector<const PointInnovation*> used;
+  int left_failures = 0;
+  for (const PointInnovation& inn : innovations) {
+    if (inn.nis <= config_.outlier_gate) {
+      used.push_back(&inn);
+    } else {
+      report.outliers.push_back(points_[inn.point].id);
+      remove[inn.point] = true;
+      if (inn.nis_left > kLeftGate) ++left_failures;
+    }
+  }
+  const int tested = static_cast<int>(innovations.size());
+  if (tested >= config_.jump_min_points &&
+      report.outliers.size() >= config_.jump_rejected_fraction * tested) {
+    // The left image does not see x_camr: if it fails too, x_caml moved (via eq. 8).
+    report.jump = 2 * left_failures >= static_cast<int>(report.outliers.size())
+                      ? JumpBlock::kVehicleToLeft
+                      : JumpBlock::kLeftToRight;
+    if (shared) marginalizeMotionError(P);
+    reopenBlock(report.jump);
+    report.lost.reserve(points_.size());
+    for (const TrackedPoint& point : points_) report.lost.push_back(point.id);
+    report.outliers.clear();
+    points_.clear();
+    index_.clear();
+    report.message = "sudden calibration change detected; points re-initialised";
+    return report;
+  }
+
+  // ---- Kalman update of the global block with the points marginalised ----
+  // Each residual r_i = J_i dg + n_i, n_i ~ N(0, S0_i) independent given g, so the update
+  // is a sequence of small exact updates (Joseph form for numerical symmetry).
+  VectorXd dg = VectorXd::Zero(G);
+  const MatrixXd identity = MatrixXd::Identity(G, G);
+  double nis_sum = 0.0;
+  for (const PointInnovation* inn : used) {
+    const Eigen::Matrix4d S = inn->J * P * inn->J.transpose() + inn->S0;
+    const MatrixXd K = P * inn->J.transpose() * S.inverse();
+    dg += K * (inn->residual - inn->J * dg);
+    const MatrixXd IKJ = identity - K * inn->J;
+    P = IKJ * P * IKJ.transpose() + K * inn->S0 * K.transpose();
+    nis_sum += inn->nis;
+  }
+  report.measurements_used = static_cast<int>(used.size());
+  report.mean_nis = used.empty() ? 0.0 : nis_sum / used.size();
+
+  // ---- each point given the global error: e_i | z_i, then re-expressed on the new g ----
+  for (const PointInnovation* inn : used) {
+    TrackedPoint& point = points_[inn->point];
+    const Eigen::Matrix<double, 3, 4> K = point.D * inn->H_p.transpose() * inn->S0.inverse();
+    point.mean += K * inn->residual + (point.B - K * inn->J) * dg;
+    point.B -= K * inn->J;
+    const Eigen::Matrix3d IKH = Eigen::Matrix3d::Identity() - K * inn->H_p;
+    point.D = IKH * point.D * IKH.transpose() +
+              K * (inn->S0 - inn->H_p * point.D * inn->H_p.transpose()) * K.transpose();
+  }
+
+  // ---- apply the correction on the manifold; drop the step's motion error ----
+  extrinsics_.T_veh_caml = boxPlus(extrinsics_.T_veh_caml, dg.segment<6>(layout::kCaml));
+  extrinsics_.T_caml_camr = boxPlus(extrinsics_.T_caml_camr, dg.segment<6>(layout::kCamr));
+  if (shared) {
+    marginalizeMotionError(P);
+  } else {
+    covariance_ = P;
+  }
+  report.covariance_repaired = repairCovariance();
+
+  for (size_t i = 0; i < points_.size(); ++i) {
+    if (!measured[i]) {  // not found in both images, or not predictable: Sec. II-C deletion
+      report.lost.push_back(points_[i].id);
+      remove[i] = true;
+    }
+  }
+  removeIndices(remove);
+  if (innovations.empty()) report.message = "no usable measurements: prediction only";
+  return report;
+}
+
+void CalibrationFilter::marginalizeMotionError(const MatrixXd& P) {
+  // Regress every point on the calibration alone: B = B_c + B_m P_mc P_cc^-1 and
+  // D += B_m (P_mm - P_mc P_cc^-1 P_cm) B_m^T. Exact per point; the small common part left
+  // by the step's motion error is not kept between points.
+  const Matrix12d P_cc = P.topLeftCorner<12, 12>();
+  const Eigen::Matrix<double, 6, 12> P_mc = P.bottomLeftCorner<6, 12>();
+  const Eigen::Matrix<double, 6, 12> regression = P_cc.llt().solve(P_mc.transpose()).transpose();
+  const Matrix6d conditional = P.bottomRightCorner<6, 6>() - regression * P_mc.transpose();
+  for (TrackedPoint& point : points_) {
+    if (point.B.cols() != layout::kAugmentedDim) continue;
+    const Eigen::Matrix<double, 3, 6> B_m = point.B.rightCols<6>();
+    const Eigen::Matrix<double, 3, 12> B_c = point.B.leftCols<12>() + B_m * regression;
+    point.D += B_m * conditional * B_m.transpose();
+    point.B = B_c;
+  }
+  covariance_ = P_cc;
+}
+
+void CalibrationFilter::reopenBlock(JumpBlock block) {
+  if (block == JumpBlock::kNone) return;
+  const int first = block == JumpBlock::kVehicleToLeft ? layout::kCaml : layout::kCamr;
+  Vector6d variance = covariance_.diagonal().segment<6>(first);
+  for (int k = 0; k < 3; ++k) {
+    variance(layout::kTranslation + k) =
+        std::max(variance(layout::kTranslation + k), std::pow(config_.jump_translation_sigma, 2));
+    variance(layout::kRotation + k) =
+        std::max(variance(layout::kRotation + k), std::pow(config_.jump_rotation_sigma, 2));
+  }
+  // Decorrelate the re-opened block from the rest: its old correlations no longer hold.
+  covariance_.middleRows<6>(first).setZero();
+  covariance_.middleCols<6>(first).setZero();
+  covariance_.block<6, 6>(first, first) = variance.asDiagonal();
+}
+
+bool CalibrationFilter::repairCovariance() {
+  // Keep P symmetric; if rounding made it indefinite, clamp its spectrum (reported).
+  MatrixXd P = covariance_;
+  const double floor = 1e-18;
+  const bool repaired = makeSymmetricPsd(&P, 0.0);
+  if (Eigen::LLT<MatrixXd>(P).info() != Eigen::Success) {
+    makeSymmetricPsd(&P, floor);
+    covariance_ = P;
+    return true;
+  }
+  covariance_ = P;
+  for (TrackedPoint& point : points_) {
+    MatrixXd D = point.D;
+    if (makeSymmetricPsd(&D, 1e-12)) point.D = D;
+  }
+  return repaired;
+}
+
+void CalibrationFilter::removeIndices(const std::vector<bool>& remove) {
+  size_t kept = 0;
+  for (size_t i = 0; i < points_.size(); ++i) {
+    if (!remove[i]) points_[kept++] = std::move(points_[i]);
+  }
+  points_.resize(kept);
+  rebuildIndex();
+}
+
+void CalibrationFilter::rebuildIndex() {
+  index_.clear();
+  for (size_t i = 0; i < points_.size(); ++i) index_[points_[i].id] = i;
+}
+
+bool CalibrationFilter::addPoint(const PointMeasurement& m) {
+  if (hasPoint(m.id) || !m.z.allFinite() || !m.variance.allFinite() || !(m.variance.minCoeff() > 0.0)) {
+    return false;
+  }
+  // Scaled UT over [x_camr (6), left pixel noise (2), right pixel noise (2)] (Sec. II-A).
+  MatrixXd C = MatrixXd::Zero(10, 10);
+  C.topLeftCorner<6, 6>() = covariance_.block<6, 6>(layout::kCamr, layout::kCamr);
+  C.bottomRightCorner<4, 4>() = m.variance.asDiagonal();
+  const double min_depth = config_.min_point_depth, max_depth = config_.max_point_depth;
+  const VectorFunction triangulate = [&](const VectorXd& x, VectorXd* y) {
+    const Eigen::Isometry3d T_lopt_ropt = leftToRightOptical(boxPlus(extrinsics_.T_caml_camr, x.head<6>()));
+    const auto p = triangulateStereo(m.z + x.tail<4>(), T_lopt_ropt, intrinsics_);
+    if (!p || p->z() < 0.5 * min_depth || p->z() > 2.0 * max_depth) return false;
+    *y = *p;
+    return true;
+  };
+  UnscentedResult ut;
+  if (!unscentedTransform(VectorXd::Zero(10), C, triangulate, ut_, &ut)) return false;
+  if (ut.mean.z() < min_depth || ut.mean.z() > max_depth) return false;
+  TrackedPoint point;
+  point.id = m.id;
+  point.mean = ut.mean;
+  point.B = MatrixXd::Zero(3, layout::kCalibrationDim);
+  point.B.middleCols<6>(layout::kCamr) = ut.jacobian.leftCols<6>();
+  // D = Cov(p) - B P B^T: what the calibration does not explain (pixel noise, nonlinearity).
+  MatrixXd D = ut.covariance - point.B * covariance_ * point.B.transpose();
+  makeSymmetricPsd(&D, 1e-12);
+  point.D = D;
+  index_[point.id] = points_.size();
+  points_.push_back(std::move(point));
+  return true;
+}
+
+void CalibrationFilter::removePoint(PointId id) {
+  const auto found = index_.find(id);
+  if (found == index_.end()) return;
+  std::vector<bool> remove(points_.size(), false);
+  remove[found->second] = true;
+  removeIndices(remove);
+}
+
+Matrix12d CalibrationFilter::parameterCovariance() const {
+  const Matrix12d J = parameterJacobian(extrinsics_);
+  return J * covariance_ * J.transpose();
+}
+
+std::vector<PointEstimate> CalibrationFilter::points() const {
+  std::vector<PointEstimate> result;
+  result.reserve(points_.size());
+  for (const TrackedPoint& point : points_) {
+    PointEstimate e;
+    e.id = point.id;
+    e.position_lopt = point.mean;
+    e.covariance = point.B * covariance_ * point.B.transpose() + point.D;
+    result.push_back(e);
+  }
+  return result;
+}
+
+MatrixXd CalibrationFilter::denseCovariance() const {
+  const int n = 12 + 3 * static_cast<int>(points_.size());
+  MatrixXd full = MatrixXd::Zero(n, n);
+  full.topLeftCorner<12, 12>() = covariance_;
+  for (size_t i = 0; i < points_.size(); ++i) {
+    const int a = 12 + 3 * static_cast<int>(i);
+    const MatrixXd BP = points_[i].B * covariance_;
+    full.block(a, 0, 3, 12) = BP;
+    full.block(0, a, 12, 3) = BP.transpose();
+    for (size_t j = 0; j < points_.size(); ++j) {
+      const int b = 12 + 3 * static_cast<int>(j);
+      full.block(a, b, 3, 3) = BP * points_[j].B.transpose();
+    }
+    full.block(a, a, 3, 3) += points_[i].D;
+  }
+  return full;
+}
+
+}  // namespace osc

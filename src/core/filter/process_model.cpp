@@ -1,0 +1,63 @@
+#include "online_stereo_calibration/core/filter/process_model.h"
+
+#include <cmath>
+
+#include "online_stereo_calibration/core/filter/state_layout.h"
+
+namespace osc {
+
+Eigen::Vector3d predictPoint(const Eigen::Vector3d& point_lopt, const Eigen::Isometry3d& T_veh_lopt,
+                             const Eigen::Isometry3d& T_prev_curr) {
+  const Eigen::Vector3d in_vehicle_prev = T_veh_lopt * point_lopt;                   // eq. 8, H^veh_caml
+  const Eigen::Vector3d in_vehicle_curr = T_prev_curr.inverse() * in_vehicle_prev;  // H^veh_veh(k+1|k)
+  return T_veh_lopt.inverse() * in_vehicle_curr;                                      // H^caml_veh
+}
+
+double noiseScale(const FilterConfig& config, double dt) { return dt / config.reference_period; }
+
+Matrix12d calibrationDriftCovariance(const FilterConfig& config, double dt) {
+  using namespace layout;
+  const double s = noiseScale(config, dt);
+  Vector12d sigma;
+  sigma.segment<3>(kCaml + kTranslation).setConstant(config.caml_translation_drift);
+  sigma.segment<3>(kCaml + kRotation).setConstant(config.caml_rotation_drift);
+  sigma.segment<3>(kCamr + kTranslation).setConstant(config.camr_translation_drift);
+  sigma.segment<3>(kCamr + kRotation).setConstant(config.camr_rotation_drift);
+  return (sigma.array().square() * s).matrix().asDiagonal();
+}
+
+Matrix6d motionNoiseCovariance(const FilterConfig& config, double dt) {
+  const double s = noiseScale(config, dt);
+  Vector6d sigma;
+  sigma.head<3>().setConstant(config.motion_translation_noise);
+  sigma.tail<3>().setConstant(config.motion_rotation_noise);
+  return (sigma.array().square() * s).matrix().asDiagonal();
+}
+
+Eigen::Matrix3d paperPointProcessNoise(const Eigen::Vector3d& point_lopt, double sigma_imu,
+                                       double sigma_p) {
+  const Eigen::Vector3d p = rotationBodyOptical() * point_lopt;  // body axes: x fwd, y left, z up
+  const double x = p.x(), y = p.y(), z = p.z();
+  // Half the chord swept by an angle error sigma in each rotation plane (eq. 16-24);
+  // the angle of the point in the plane is atan2 of its two coordinates.
+  const auto sweep_sin = [sigma_imu](double angle, double radius) {
+    return radius * (std::sin(angle + sigma_imu) - std::sin(angle - sigma_imu)) / 2.0;
+  };
+  const auto sweep_cos = [sigma_imu](double angle, double radius) {
+    return radius * (std::cos(angle + sigma_imu) - std::cos(angle - sigma_imu)) / 2.0;
+  };
+  const double phi = std::atan2(z, y), r_yz = std::hypot(y, z);    // roll, eq. 16
+  const double theta = std::atan2(z, x), r_xz = std::hypot(x, z);  // pitch, eq. 17
+  const double psi = std::atan2(y, x), r_xy = std::hypot(x, y);    // yaw, eq. 18
+  const double s_phi_z = sweep_sin(phi, r_yz), s_phi_y = sweep_cos(phi, r_yz);        // eq. 19-20
+  const double s_theta_z = sweep_sin(theta, r_xz), s_theta_x = sweep_cos(theta, r_xz);  // eq. 21-22
+  const double s_psi_x = sweep_cos(psi, r_xy), s_psi_y = sweep_sin(psi, r_xy);        // eq. 23-24
+  const double sp2 = sigma_p * sigma_p;
+  const Eigen::Vector3d q_body(s_theta_x * s_theta_x + s_psi_x * s_psi_x + sp2,   // eq. 25
+                               s_phi_y * s_phi_y + s_psi_y * s_psi_y + sp2,       // eq. 26
+                               s_phi_z * s_phi_z + s_theta_z * s_theta_z + sp2);  // eq. 27
+  const Eigen::Matrix3d& R = rotationBodyOptical();
+  return R.transpose() * q_body.asDiagonal() * R;
+}
+
+}  // namespace osc

@@ -1,0 +1,278 @@
+// The structured filter: agreement with a plain dense UKF of the same model, point
+// initialisation against Monte Carlo, and bad input.
+#include <cmath>
+#include <random>
+
+#include <Eigen/Cholesky>
+#include <gtest/gtest.h>
+
+#include "online_stereo_calibration/core/filter/calibration_filter.h"
+#include "online_stereo_calibration/core/filter/dense_calibration_ukf.h"
+#include "online_stereo_calibration/core/filter/process_model.h"
+#include "online_stereo_calibration/core/geometry/rotation.h"
+
+namespace osc {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+/// A few static world points, a true calibration, a wrong guess and a short drive.
+struct SmallProblem {
+  StereoIntrinsics K;
+  StereoExtrinsics truth, guess;
+  std::vector<Eigen::Vector3d> world;
+  std::vector<Eigen::Isometry3d> T_world_veh;
+  std::mt19937_64 rng{3};
+
+  SmallProblem(int points, int frames) {
+    K.K_left << 600, 0, 320, 0, 600, 240, 0, 0, 1;
+    K.K_right = K.K_left;
+    Vector12d p;
+    p << 1.5, 0.15, 1.3, 0.0, 0.05, 0.0, 0.0, -0.3, 0.0, 0.0, 0.0, 0.0;
+    truth = StereoExtrinsics::fromParameters(p);
+    Vector12d err;
+    err << 0.05, -0.05, 0.05, 1 * kDeg, -1 * kDeg, 1 * kDeg, 0.0, 0.01, 0.0, 0.1 * kDeg, 0.0, 0.0;
+    guess = StereoExtrinsics::fromParameters(p + err);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (int i = 0; i < points; ++i) {
+      world.emplace_back(12 + 8 * u(rng), 4 * u(rng), 1.3 + 1.5 * u(rng));
+    }
+    for (int k = 0; k < frames; ++k) {
+      Vector6d w;
+      w << 0.35 * k, 0.0, 0.02 * std::sin(k), 0.03 * std::sin(0.7 * k), 0.03 * std::cos(0.9 * k), 0.02 * k;
+      T_world_veh.push_back(poseFromParameters(w));
+    }
+  }
+
+  MotionIncrement motion(int k) const {
+    MotionIncrement m;
+    m.T_prev_curr = T_world_veh[k - 1].inverse() * T_world_veh[k];
+    m.dt = 0.1;
+    return m;
+  }
+
+  std::vector<PointMeasurement> measure(int k, double pixel_noise) {
+    std::normal_distribution<double> n(0.0, pixel_noise);
+    const Eigen::Isometry3d T_lopt_world = (T_world_veh[k] * truth.vehicleToLeftOptical()).inverse();
+    const Eigen::Isometry3d T_ropt_lopt = truth.leftToRightOptical().inverse();
+    std::vector<PointMeasurement> out;
+    for (size_t i = 0; i < world.size(); ++i) {
+      PointMeasurement m;
+      m.id = i + 1;
+      EXPECT_TRUE(projectStereo(T_lopt_world * world[i], T_ropt_lopt, K, 0.1, &m.z));
+      for (int c = 0; c < 4; ++c) m.z(c) += n(rng);
+      m.variance.setConstant(std::max(pixel_noise, 0.3) * std::max(pixel_noise, 0.3));
+      out.push_back(m);
+    }
+    return out;
+  }
+};
+
+Matrix12d guessCovariance(double scale = 1.0) {
+  Vector12d sigma;
+  sigma << 0.1, 0.1, 0.1, 2 * kDeg, 2 * kDeg, 2 * kDeg, 0.02, 0.02, 0.02, 0.3 * kDeg, 0.3 * kDeg, 0.3 * kDeg;
+  return (scale * sigma).array().square().matrix().asDiagonal();
+}
+
+void expectFiltersAgree(MotionNoiseModel model) {
+  SmallProblem problem(6, 6);
+  FilterConfig config;
+  config.motion_noise_model = model;
+  CalibrationFilter structured(config, problem.K);
+  DenseCalibrationUkf dense(config, problem.K);
+  // A mildly nonlinear regime: the two filters linearise with different sigma-point
+  // spreads (local 9-15 dimensions vs 2n+1 over all 30), which differ at second order.
+  const Vector12d truth = problem.truth.toParameters();
+  problem.guess = StereoExtrinsics::fromParameters(truth + 0.05 * (problem.guess.toParameters() - truth));
+  structured.reset(problem.guess, guessCovariance(0.05));
+  dense.reset(problem.guess, guessCovariance(0.05));
+  for (const PointMeasurement& m : problem.measure(0, 0.3)) {
+    ASSERT_TRUE(structured.addPoint(m));
+    ASSERT_TRUE(dense.addPoint(m));
+  }
+  ASSERT_TRUE(structured.denseCovariance().isApprox(dense.covariance(), 1e-9));
+  for (int k = 1; k < 6; ++k) {
+    const auto measurements = problem.measure(k, 0.3);
+    const StepReport report = structured.step(problem.motion(k), measurements);
+    ASSERT_TRUE(report.accepted);
+    ASSERT_EQ(report.measurements_used, 6);
+    ASSERT_TRUE(dense.step(problem.motion(k), measurements));
+  }
+  // Calibration: same estimate to a small fraction of its sigma, same covariance to a few %.
+  const Matrix12d P = structured.covariance();
+  const Matrix12d P_dense = dense.covariance().topLeftCorner<12, 12>();
+  Vector12d difference;
+  difference.head<6>() = boxMinus(structured.extrinsics().T_veh_caml, dense.extrinsics().T_veh_caml);
+  difference.tail<6>() = boxMinus(structured.extrinsics().T_caml_camr, dense.extrinsics().T_caml_camr);
+  for (int k = 0; k < 12; ++k) {
+    EXPECT_LT(std::abs(difference(k)), 0.1 * std::sqrt(P_dense(k, k))) << "parameter " << k;
+    EXPECT_NEAR(std::sqrt(P(k, k)), std::sqrt(P_dense(k, k)), 0.05 * std::sqrt(P_dense(k, k))) << k;
+  }
+  // The filters really learned something (else agreement would be trivial).
+  Vector12d moved;
+  moved.head<6>() = boxMinus(structured.extrinsics().T_veh_caml, problem.guess.T_veh_caml);
+  moved.tail<6>() = boxMinus(structured.extrinsics().T_caml_camr, problem.guess.T_caml_camr);
+  const Vector12d prior_sigma = guessCovariance(0.05).diagonal().cwiseSqrt();
+  EXPECT_GT(moved.cwiseQuotient(prior_sigma).cwiseAbs().maxCoeff(), 0.3);
+  // Points and the whole covariance.
+  const auto points = structured.points();
+  const Eigen::MatrixXd full = structured.denseCovariance();
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d d = points[i].position_lopt - dense.pointMeans()[i];
+    EXPECT_LT(d.norm(), 0.3 * std::sqrt(points[i].covariance.trace())) << "point " << i;
+  }
+  EXPECT_LT((full - dense.covariance()).norm(), 0.1 * dense.covariance().norm());
+}
+
+TEST(CalibrationFilter, AgreesWithDenseUkfPaperMotionNoise) { expectFiltersAgree(MotionNoiseModel::kPerPoint); }
+TEST(CalibrationFilter, AgreesWithDenseUkfSharedMotionNoise) { expectFiltersAgree(MotionNoiseModel::kShared); }
+
+TEST(CalibrationFilter, NewPointCrossCovarianceMatchesMonteCarlo) {
+  // Sec. II-A: the point's covariance and its cross-covariance with x_camr come out of the
+  // SUT through triangulation. Check both against sampling the same inputs.
+  SmallProblem problem(1, 1);
+  problem.world = {Eigen::Vector3d(7.0, 0.5, 1.0)};  // 5.5 m ahead: depth still near-Gaussian
+  FilterConfig config;
+  CalibrationFilter filter(config, problem.K);
+  filter.reset(problem.guess, guessCovariance());
+  PointMeasurement m = problem.measure(0, 0.0).front();
+  m.variance.setConstant(0.25);
+  ASSERT_TRUE(filter.addPoint(m));
+  const Eigen::MatrixXd joint = filter.denseCovariance();
+
+  const Eigen::Matrix<double, 6, 6> P_rr = guessCovariance().block<6, 6>(6, 6);
+  const Eigen::Matrix<double, 6, 6> L = P_rr.llt().matrixL();
+  std::normal_distribution<double> n01;
+  const int samples = 100000;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  std::vector<std::pair<Vector6d, Eigen::Vector3d>> draws;
+  for (int s = 0; s < samples; ++s) {
+    Vector6d w, dr;
+    for (int k = 0; k < 6; ++k) w(k) = n01(problem.rng);
+    dr = L * w;
+    Eigen::Vector4d z = m.z;
+    for (int k = 0; k < 4; ++k) z(k) += 0.5 * n01(problem.rng);
+    StereoExtrinsics e = problem.guess;
+    e.T_caml_camr = boxPlus(e.T_caml_camr, dr);
+    const auto p = triangulateStereo(z, e.leftToRightOptical(), problem.K);
+    ASSERT_TRUE(p.has_value());
+    draws.emplace_back(dr, *p);
+    mean += *p;
+  }
+  mean /= samples;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  Eigen::Matrix<double, 3, 6> cross = Eigen::Matrix<double, 3, 6>::Zero();
+  for (const auto& d : draws) {
+    cov += (d.second - mean) * (d.second - mean).transpose();
+    cross += (d.second - mean) * d.first.transpose();
+  }
+  cov /= samples - 1;
+  cross /= samples - 1;
+  const Eigen::Vector3d ut_mean = filter.points().front().position_lopt;
+  EXPECT_LT((ut_mean - mean).norm(), 0.1 * std::sqrt(cov.trace()));
+  EXPECT_LT((joint.block<3, 3>(12, 12) - cov).norm(), 0.1 * cov.norm());
+  EXPECT_LT((joint.block<3, 6>(12, 6) - cross).norm(), 0.1 * cross.norm());
+  // No direct dependence on x_caml: that block is zero here (prior has no caml-camr correlation).
+  EXPECT_LT((joint.block<3, 6>(12, 0).norm()), 1e-12);
+}
+
+/// A filter with points after a few steps, for the bad-input tests.
+class FilterWithPoints : public ::testing::Test {
+ protected:
+  FilterWithPoints() : problem(20, 8), filter(FilterConfig(), problem.K) {
+    filter.reset(problem.guess, guessCovariance());
+    for (const PointMeasurement& m : problem.measure(0, 0.5)) filter.addPoint(m);
+    for (int k = 1; k < 4; ++k) filter.step(problem.motion(k), problem.measure(k, 0.5));
+  }
+  void expectUntouched(const CalibrationFilter& before) const {
+    EXPECT_TRUE(filter.covariance() == before.covariance());
+    EXPECT_TRUE(filter.extrinsics().T_veh_caml.matrix() == before.extrinsics().T_veh_caml.matrix());
+    EXPECT_TRUE(filter.extrinsics().T_caml_camr.matrix() == before.extrinsics().T_caml_camr.matrix());
+    EXPECT_EQ(filter.pointCount(), before.pointCount());
+  }
+  void expectValid() const {
+    EXPECT_TRUE(filter.covariance().allFinite());
+    EXPECT_TRUE(filter.covariance().isApprox(filter.covariance().transpose(), 1e-12));
+    EXPECT_EQ(Eigen::LLT<Matrix12d>(filter.covariance()).info(), Eigen::Success);
+    EXPECT_TRUE(filter.extrinsics().T_veh_caml.matrix().allFinite());
+  }
+  SmallProblem problem;
+  CalibrationFilter filter;
+};
+
+TEST_F(FilterWithPoints, NanMotionIsRejectedAndStateUntouched) {
+  const CalibrationFilter before = filter;
+  MotionIncrement m = problem.motion(4);
+  m.T_prev_curr.translation().x() = std::nan("");
+  const StepReport report = filter.step(m, problem.measure(4, 0.5));
+  EXPECT_FALSE(report.accepted);
+  EXPECT_NE(report.message.find("NaN"), std::string::npos);
+  expectUntouched(before);
+}
+
+TEST_F(FilterWithPoints, AbsurdMotionIsRejectedAndStateUntouched) {
+  const CalibrationFilter before = filter;
+  MotionIncrement m = problem.motion(4);
+  m.T_prev_curr.translation() << 50.0, 0.0, 0.0;  // 500 m/s
+  StepReport report = filter.step(m, problem.measure(4, 0.5));
+  EXPECT_FALSE(report.accepted);
+  EXPECT_NE(report.message.find("max_speed_mps"), std::string::npos);
+  m = problem.motion(4);
+  m.T_prev_curr.linear() = expSO3(Eigen::Vector3d(0, 0, 1.0));  // 1 rad in 0.1 s
+  report = filter.step(m, problem.measure(4, 0.5));
+  EXPECT_FALSE(report.accepted);
+  EXPECT_NE(report.message.find("max_angular_rate_dps"), std::string::npos);
+  m = problem.motion(4);
+  m.dt = -0.1;
+  EXPECT_FALSE(filter.step(m, problem.measure(4, 0.5)).accepted);
+  expectUntouched(before);
+}
+
+TEST_F(FilterWithPoints, NanMeasurementIsIgnoredAndCounted) {
+  auto measurements = problem.measure(4, 0.5);
+  measurements[3].z(2) = std::numeric_limits<double>::infinity();
+  measurements[5].variance(0) = -1.0;
+  const size_t before = filter.pointCount();
+  const StepReport report = filter.step(problem.motion(4), measurements);
+  EXPECT_TRUE(report.accepted);
+  EXPECT_EQ(report.invalid_measurements, 2);
+  EXPECT_EQ(report.measurements_used, static_cast<int>(before) - 2);
+  EXPECT_EQ(filter.pointCount(), before - 2);  // not validly measured: removed (Sec. II-C)
+  expectValid();
+}
+
+TEST_F(FilterWithPoints, EmptyFrameLosesAllPointsButKeepsTheCalibration) {
+  const Matrix12d P_before = filter.covariance();
+  const Vector12d p_before = filter.extrinsics().toParameters();
+  const StepReport report = filter.step(problem.motion(4), {});
+  EXPECT_TRUE(report.accepted);
+  EXPECT_EQ(report.lost.size(), 20u);
+  EXPECT_EQ(filter.pointCount(), 0u);
+  EXPECT_TRUE(filter.extrinsics().toParameters().isApprox(p_before, 1e-12));
+  EXPECT_GE(filter.covariance()(0, 0), P_before(0, 0));  // drift only grows it
+  expectValid();
+  // And it goes on: new points can be added and used.
+  for (const PointMeasurement& m : problem.measure(4, 0.5)) filter.addPoint(m);
+  EXPECT_EQ(filter.step(problem.motion(5), problem.measure(5, 0.5)).measurements_used, 20);
+  expectValid();
+}
+
+TEST_F(FilterWithPoints, GrossOutlierIsGatedOut) {
+  auto measurements = problem.measure(4, 0.5);
+  measurements[7].z(0) += 40.0;  // a wrong match 40 px off
+  const StepReport report = filter.step(problem.motion(4), measurements);
+  ASSERT_EQ(report.outliers.size(), 1u);
+  EXPECT_EQ(report.outliers[0], measurements[7].id);
+  EXPECT_EQ(report.jump, JumpBlock::kNone);
+  EXPECT_FALSE(filter.hasPoint(measurements[7].id));
+  expectValid();
+}
+
+TEST_F(FilterWithPoints, ResetRejectsAnIndefiniteCovariance) {
+  Matrix12d bad = guessCovariance();
+  bad(0, 0) = -1.0;
+  EXPECT_THROW(filter.reset(problem.guess, bad), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace osc
