@@ -1,0 +1,119 @@
+// The paper's experiment and its variations at measurement level (simulated pixels and
+// motion), end to end through the estimator facade: accuracy against the seed's Table I,
+// honesty of the uncertainty, any mounting, and observability.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "online_stereo_calibration/core/sim/scenario_runner.h"
+
+namespace osc {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// Seed Table I, RMSE over frames 1000-1150 (algorithm.md), m and rad.
+const double kPaperRmse[12] = {0.0608, 0.0382, 0.0132, 0.2995 * kDeg, 0.7061 * kDeg, 0.2844 * kDeg,
+                               0.0044, 0.0048, 0.0037, 0.0236 * kDeg, 0.0174 * kDeg, 0.0193 * kDeg};
+const char* kNames[12] = {"xl", "yl", "zl", "roll_l", "pitch_l", "yaw_l",
+                          "xr", "yr", "zr", "roll_r", "pitch_r", "yaw_r"};
+
+Vector12d parameterError(const ScenarioFrameResult& r) {
+  Vector12d e = r.parameters - r.truth;
+  for (int k : {3, 4, 5, 9, 10, 11}) e(k) = std::remainder(e(k), 2.0 * M_PI);
+  return e;
+}
+
+// Paper scenario: start errors 0.5 m / 10 deg on x_caml, 0.1 m on yr, 10 Hz, 1500 frames,
+// a 10 deg yaw step of x_caml at frame 774. Pooled over three drives (seeds) so that one
+// unlucky realisation of the motion noise neither passes nor fails the estimator alone.
+TEST(PaperScenario, BeatsTableIAndIsNotOverconfident) {
+  Vector12d squared_error = Vector12d::Zero(), within_2sigma = Vector12d::Zero();
+  int frames = 0;
+  for (unsigned seed : {1u, 2u, 3u}) {
+    MeasurementScenario scenario = paperOffroadScenario();
+    scenario.seed = seed;
+    int recovered_at = -1;
+    const auto results = runMeasurementScenario(scenario, FilterConfig());
+    ASSERT_EQ(results.size(), 1500u);
+    for (const ScenarioFrameResult& r : results) {
+      const Vector12d e = parameterError(r);
+      if (r.frame > 774 && recovered_at < 0 && std::abs(e(5)) < 0.3 * kDeg) recovered_at = r.frame;
+      if (r.frame < 1000 || r.frame > 1150) continue;
+      squared_error += e.cwiseAbs2();
+      for (int k = 0; k < 12; ++k) within_2sigma(k) += std::abs(e(k)) <= 2.0 * r.sigmas(k);
+      ++frames;
+    }
+    // The step is detected and tracked back to 0.3 deg within 150 frames.
+    EXPECT_GT(recovered_at, 774) << "seed " << seed;
+    EXPECT_LT(recovered_at, 774 + 150) << "seed " << seed;
+  }
+  for (int k = 0; k < 12; ++k) {
+    const double rmse = std::sqrt(squared_error(k) / frames);
+    EXPECT_LT(rmse, kPaperRmse[k]) << kNames[k];
+    EXPECT_GE(within_2sigma(k) / frames, 0.9) << kNames[k];
+  }
+}
+
+/// Runs a short drive without step and returns the last frame.
+ScenarioFrameResult lastFrame(MeasurementScenario scenario, int frames) {
+  scenario.frames = frames;
+  scenario.step_frame = -1;
+  const auto results = runMeasurementScenario(scenario, FilterConfig());
+  return results.back();
+}
+
+// The filter's arithmetic has no roll/pitch/yaw: a camera looking straight down (pitch 90 deg,
+// where RPY is singular) or backwards converges like the forward one.
+TEST(Mounting, DownwardAndBackwardCamerasConvergeLikeTheForwardOne) {
+  MeasurementScenario forward = paperOffroadScenario();
+  MeasurementScenario down = forward, backward = forward;
+  down.truth(4) = M_PI / 2.0;  // pitch_l: optical axis along -z of the vehicle
+  backward.truth(5) = M_PI;    // yaw_l: looking back
+  const ScenarioFrameResult f = lastFrame(forward, 500);
+  for (const MeasurementScenario& s : {down, backward}) {
+    const ScenarioFrameResult r = lastFrame(s, 500);
+    const double rotation_error = r.tangent_error.segment<3>(3).norm();
+    const double translation_error = r.tangent_error.head<3>().norm();
+    EXPECT_LT(rotation_error, 0.5 * kDeg) << "pitch " << s.truth(4) << " yaw " << s.truth(5);
+    EXPECT_LT(translation_error, 0.06);
+    EXPECT_LT(r.tangent_error.tail<6>().norm(), 0.01);
+    // Like the forward camera: same order of accuracy, and honest (NEES of 12 dof).
+    EXPECT_LT(rotation_error, 5.0 * std::max(f.tangent_error.segment<3>(3).norm(), 0.05 * kDeg));
+    EXPECT_LT(r.nees, 40.0);
+  }
+}
+
+// Seed Sec. II-D: with planar motion (no roll or pitch) zl is unobservable, so its sigma
+// must not shrink; with rotation about two axes it does.
+TEST(Observability, CameraHeightNeedsRollOrPitch) {
+  MeasurementScenario planar = paperOffroadScenario();
+  planar.motion.planar = true;
+  planar.initial_error.setZero();  // isolate the information content from convergence
+  MeasurementScenario rolling = planar;
+  rolling.motion.planar = false;
+  const double initial_sigma = FilterConfig().initial_caml_translation_sigma;
+  const ScenarioFrameResult p = lastFrame(planar, 300);
+  const ScenarioFrameResult r = lastFrame(rolling, 300);
+  // zl: learned with roll/pitch, not without. (Without, the sigma still drops to ~half:
+  // the filter linearises at the *measured* motion, whose 0.02 deg roll/pitch noise looks
+  // like excitation. Iterating the step at the corrected motion would remove that.)
+  EXPECT_LT(r.sigmas(2), 0.1 * initial_sigma);
+  EXPECT_GT(p.sigmas(2), 0.3 * initial_sigma);
+  EXPECT_GT(p.sigmas(2), 10.0 * r.sigmas(2));
+  EXPECT_LT(p.sigmas(0), 0.2 * initial_sigma);   // xl is learned either way
+  EXPECT_LT(std::abs(p.parameters(2) - p.truth(2)), 3.0 * p.sigmas(2));  // and honest
+}
+
+// Gross outliers (wrong matches) must not drag the calibration.
+TEST(Robustness, FivePercentGrossOutliersDoNotDragTheCalibration) {
+  MeasurementScenario scenario = paperOffroadScenario();
+  scenario.outlier_fraction = 0.05;
+  const ScenarioFrameResult r = lastFrame(scenario, 500);
+  EXPECT_LT(r.tangent_error.segment<3>(3).norm(), 0.5 * kDeg);
+  EXPECT_LT(r.tangent_error.tail<6>().norm(), 0.01);
+  EXPECT_LT(r.nees, 40.0);
+}
+
+}  // namespace
+}  // namespace osc
