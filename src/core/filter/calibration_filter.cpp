@@ -52,6 +52,20 @@ MatrixXd jointCovariance(const MatrixXd& P, const std::vector<int>& selected, co
   return C;
 }
 
+/// The scaled UT with the configured spread; where f is undefined at some sigma point (a
+/// ray pair that does not meet, a point behind a camera), retried with the sigma points
+/// pulled in (alpha / 4, / 16): the scaling Julier introduced for exactly such non-local
+/// effects, tending to the linearised transform.
+bool unscentedTransformWithFallback(const VectorXd& mean, const MatrixXd& covariance,
+                                    const VectorFunction& f, UnscentedParameters parameters,
+                                    UnscentedResult* result) {
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    if (unscentedTransform(mean, covariance, f, parameters, result)) return true;
+    parameters.alpha /= 4.0;
+  }
+  return false;
+}
+
 std::vector<int> range(int first, int count) {
   std::vector<int> r(count);
   for (int k = 0; k < count; ++k) r[k] = first + k;
@@ -226,8 +240,8 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
       return true;
     };
     UnscentedResult ut;
-    if (!unscentedTransform(VectorXd::Zero(9), jointCovariance(P, camr, point.B, point.D), observe,
-                            ut_, &ut)) {
+    if (!unscentedTransformWithFallback(VectorXd::Zero(9), jointCovariance(P, camr, point.B, point.D),
+                                        observe, ut_, &ut)) {
       continue;  // behind a camera for some sigma point: not measurable, dropped below
     }
     measured[i] = true;
@@ -407,7 +421,7 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
     return true;
   };
   UnscentedResult ut;
-  if (!unscentedTransform(VectorXd::Zero(10), C, triangulate, ut_, &ut)) return false;
+  if (!unscentedTransformWithFallback(VectorXd::Zero(10), C, triangulate, ut_, &ut)) return false;
   if (ut.mean.z() < min_depth || ut.mean.z() > max_depth) return false;
   TrackedPoint point;
   point.id = m.id;

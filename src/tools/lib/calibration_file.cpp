@@ -1,0 +1,210 @@
+#include "online_stereo_calibration/tools/calibration_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <locale>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+namespace osc {
+namespace {
+
+constexpr const char* kVehicleToLeft = "vehicle_to_left";
+constexpr const char* kLeftToRight = "left_to_right";
+constexpr const char* kSigmaVehicleToLeft = "sigma_vehicle_to_left";
+constexpr const char* kSigmaLeftToRight = "sigma_left_to_right";
+constexpr const char* kStamp = "stamp";
+
+[[noreturn]] void fail(const std::string& source, const std::string& what) {
+  throw std::runtime_error("calibration file '" + source + "': " + what);
+}
+
+/// One finite number from a YAML scalar.
+double readNumber(const YAML::Node& node, const std::string& source, const std::string& key) {
+  double value = 0.0;
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, value)) {
+    fail(source, "key '" + key + "' is not a number");
+  }
+  if (!std::isfinite(value)) fail(source, "key '" + key + "' is NaN or infinite");
+  return value;
+}
+
+/// A list of exactly 6 finite numbers.
+Vector6d readVector6(const YAML::Node& root, const std::string& source, const std::string& key) {
+  const YAML::Node node = root[key];
+  if (!node) fail(source, "missing key '" + key + "'");
+  if (!node.IsSequence() || node.size() != 6) {
+    fail(source, "key '" + key + "' must be a list of 6 numbers");
+  }
+  Vector6d v;
+  for (int i = 0; i < 6; ++i) {
+    v(i) = readNumber(node[i], source, key + "[" + std::to_string(i) + "]");
+  }
+  return v;
+}
+
+/// A number with 17 significant digits, locale-independent, always with a '.' in the
+/// mantissa so that YAML 1.1 readers (PyYAML) see a float, not a string.
+std::string formatNumber(double value) {
+  if (value == 0.0) value = 0.0;  // "-0.0" (from RPY extraction) reads oddly; same value
+  std::ostringstream out;
+  out.imbue(std::locale::classic());
+  out.precision(17);
+  out << value;
+  std::string text = out.str();
+  if (text.find_first_of(".ne") == std::string::npos) {
+    text += ".0";
+  } else if (text.find('.') == std::string::npos && text.find('e') != std::string::npos) {
+    text.insert(text.find('e'), ".0");
+  }
+  return text;
+}
+
+std::string formatList(const Vector6d& v) {
+  std::string text = "[";
+  for (int i = 0; i < 6; ++i) {
+    if (i > 0) text += ", ";
+    text += formatNumber(v(i));
+  }
+  return text + "]";
+}
+
+std::string errnoText() { return std::strerror(errno); }
+
+/// Writes all of @p data to @p fd; false on error (errno set).
+bool writeAll(int fd, const std::string& data) {
+  std::size_t done = 0;
+  while (done < data.size()) {
+    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+std::string directoryOf(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  if (slash == 0) return "/";
+  return path.substr(0, slash);
+}
+
+}  // namespace
+
+CalibrationFile parseCalibrationYaml(const std::string& text, const std::string& source_name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    fail(source_name, std::string("invalid YAML: ") + e.what());
+  }
+  if (!root.IsMap()) fail(source_name, "expected a map with keys vehicle_to_left, left_to_right");
+
+  CalibrationFile file;
+  // Read each half before the comma initialiser: a throw inside it trips Eigen's assert.
+  const Vector6d vehicle_to_left = readVector6(root, source_name, kVehicleToLeft);
+  const Vector6d left_to_right = readVector6(root, source_name, kLeftToRight);
+  Vector12d parameters;
+  parameters << vehicle_to_left, left_to_right;
+  file.extrinsics = StereoExtrinsics::fromParameters(parameters);
+
+  const bool has_sigma_left = static_cast<bool>(root[kSigmaVehicleToLeft]);
+  const bool has_sigma_right = static_cast<bool>(root[kSigmaLeftToRight]);
+  if (has_sigma_left || has_sigma_right) {
+    const Vector6d sigma_left = readVector6(root, source_name, kSigmaVehicleToLeft);
+    const Vector6d sigma_right = readVector6(root, source_name, kSigmaLeftToRight);
+    Vector12d sigmas;
+    sigmas << sigma_left, sigma_right;
+    for (int i = 0; i < 12; ++i) {
+      if (sigmas(i) < 0.0) {
+        fail(source_name, "key '" + std::string(i < 6 ? kSigmaVehicleToLeft : kSigmaLeftToRight) +
+                              "[" + std::to_string(i % 6) + "]' is negative");
+      }
+    }
+    file.sigmas = sigmas;
+  }
+  if (root[kStamp]) file.stamp = readNumber(root[kStamp], source_name, kStamp);
+  return file;
+}
+
+CalibrationFile readCalibrationFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("calibration file '" + path + "': cannot open for reading");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw std::runtime_error("calibration file '" + path + "': read error");
+  return parseCalibrationYaml(text.str(), path);
+}
+
+std::string formatCalibrationYaml(const CalibrationFile& file) {
+  const Vector12d p = file.extrinsics.toParameters();
+  if (!p.allFinite() || (file.sigmas && !file.sigmas->allFinite()) ||
+      (file.stamp && !std::isfinite(*file.stamp))) {
+    throw std::runtime_error("calibration: refusing to write NaN or infinite values");
+  }
+  std::string text =
+      "# online_stereo_calibration extrinsics; metres and radians; [x, y, z, roll, pitch, yaw], "
+      "R = Rz(yaw) Ry(pitch) Rx(roll).\n"
+      "# vehicle_to_left: left camera body frame (x fwd, y left, z up) in the vehicle frame "
+      "(REP 103); left_to_right: right camera body frame in the left camera body frame.\n";
+  text += std::string(kVehicleToLeft) + ": " + formatList(p.head<6>()) + "\n";
+  text += std::string(kLeftToRight) + ": " + formatList(p.tail<6>()) + "\n";
+  if (file.sigmas) {
+    text += std::string(kSigmaVehicleToLeft) + ": " + formatList(file.sigmas->head<6>()) + "\n";
+    text += std::string(kSigmaLeftToRight) + ": " + formatList(file.sigmas->tail<6>()) + "\n";
+  }
+  if (file.stamp) text += std::string(kStamp) + ": " + formatNumber(*file.stamp) + "\n";
+  return text;
+}
+
+void writeCalibrationFileAtomic(const std::string& path, const CalibrationFile& file) {
+  const std::string text = formatCalibrationYaml(file);
+  const auto failure = [&path](const std::string& what) {
+    return std::runtime_error("calibration file '" + path + "': " + what);
+  };
+
+  std::string temp = path + ".tmp.XXXXXX";
+  std::vector<char> temp_buffer(temp.begin(), temp.end());
+  temp_buffer.push_back('\0');
+  const int fd = ::mkstemp(temp_buffer.data());
+  if (fd < 0) throw failure("cannot create a temporary file: " + errnoText());
+  temp.assign(temp_buffer.data());
+
+  std::string error;
+  if (::fchmod(fd, 0644) != 0) {
+    error = "chmod: " + errnoText();
+  } else if (!writeAll(fd, text)) {
+    error = "write: " + errnoText();
+  } else if (::fsync(fd) != 0) {
+    error = "fsync: " + errnoText();
+  }
+  if (::close(fd) != 0 && error.empty()) error = "close: " + errnoText();
+  if (error.empty() && ::rename(temp.c_str(), path.c_str()) != 0) {
+    error = "rename: " + errnoText();
+  }
+  if (!error.empty()) {
+    ::unlink(temp.c_str());
+    throw failure(error + " (old file, if any, kept)");
+  }
+
+  // Make the rename itself durable. Failure here leaves a complete file in place.
+  const int dir_fd = ::open(directoryOf(path).c_str(), O_RDONLY | O_DIRECTORY);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
+}
+
+}  // namespace osc

@@ -1,0 +1,27 @@
+// Writes config/default.yaml and config/paper.yaml from the code's defaults, so the files
+// and the code cannot disagree (test_filter_config_yaml checks that they are up to date).
+//   write_default_configs CONFIG_DIR
+#include <fstream>
+#include <iostream>
+
+#include "online_stereo_calibration/tools/filter_config_yaml.h"
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::cerr << "usage: write_default_configs CONFIG_DIR\n";
+    return 2;
+  }
+  const std::string dir = argv[1];
+  std::ofstream(dir + "/default.yaml")
+      << osc::formatFilterConfigYaml(osc::FilterConfig(),
+                                     "online_stereo_calibration: shipped defaults (docs/RESULTS.md "
+                                     "has the figures behind every value that differs from "
+                                     "paper.yaml)");
+  std::ofstream(dir + "/paper.yaml")
+      << osc::formatFilterConfigYaml(osc::paperFilterConfig(),
+                                     "online_stereo_calibration: the seed paper's values (Mueller "
+                                     "& Wuensche 2016, eq. 10-15); values the paper does not give "
+                                     "are our defaults");
+  std::cout << "wrote " << dir << "/default.yaml and " << dir << "/paper.yaml\n";
+  return 0;
+}

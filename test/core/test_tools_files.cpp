@@ -1,0 +1,594 @@
+/// Tests of the tools library: calibration YAML, estimates/reference CSV, evaluation.
+#include <dirent.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <initializer_list>
+#include <limits>
+#include <random>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "online_stereo_calibration/tools/calibration_file.h"
+#include "online_stereo_calibration/tools/estimates_csv.h"
+#include "online_stereo_calibration/tools/evaluation.h"
+
+namespace osc {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+/// A fresh directory under /tmp, removed (with its files) at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    char name[] = "/tmp/osc_test_tools_XXXXXX";
+    const char* made = ::mkdtemp(name);
+    if (made == nullptr) throw std::runtime_error("mkdtemp failed");
+    path_ = made;
+  }
+  ~TempDir() {
+    ::chmod(path_.c_str(), 0755);
+    for (const std::string& entry : entries()) ::unlink((path_ + "/" + entry).c_str());
+    ::rmdir(path_.c_str());
+  }
+  const std::string& path() const { return path_; }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+  /// Names in the directory, without "." and "..".
+  std::set<std::string> entries() const {
+    std::set<std::string> names;
+    if (DIR* dir = ::opendir(path_.c_str())) {
+      while (const dirent* entry = ::readdir(dir)) {
+        const std::string name = entry->d_name;
+        if (name != "." && name != "..") names.insert(name);
+      }
+      ::closedir(dir);
+    }
+    return names;
+  }
+
+ private:
+  std::string path_;
+};
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void writeText(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+}
+
+/// Expects @p fn to throw an exception of type E whose message contains every fragment.
+template <typename E>
+void expectThrowMentioning(const std::function<void()>& fn,
+                           std::initializer_list<std::string> fragments) {
+  try {
+    fn();
+    ADD_FAILURE() << "expected an exception mentioning " << *fragments.begin();
+  } catch (const E& e) {
+    const std::string message = e.what();
+    for (const std::string& fragment : fragments) {
+      EXPECT_NE(message.find(fragment), std::string::npos)
+          << "'" << fragment << "' not in: " << message;
+    }
+  }
+}
+
+/// Random parameters in the RPY chart's regular region (|pitch| < pi/2).
+Vector12d randomParameters(std::mt19937& rng) {
+  std::uniform_real_distribution<double> metres(-3.0, 3.0);
+  std::uniform_real_distribution<double> angle(-3.1, 3.1);
+  std::uniform_real_distribution<double> pitch(-1.5, 1.5);
+  Vector12d p;
+  for (int block = 0; block < 2; ++block) {
+    p.segment<3>(6 * block) << metres(rng), metres(rng), metres(rng);
+    p.segment<3>(6 * block + 3) << angle(rng), pitch(rng), angle(rng);
+  }
+  return p;
+}
+
+CalibrationFile sampleCalibration(std::mt19937& rng) {
+  CalibrationFile file;
+  file.extrinsics = StereoExtrinsics::fromParameters(randomParameters(rng));
+  std::uniform_real_distribution<double> sigma(1e-7, 0.5);
+  Vector12d sigmas;
+  for (int i = 0; i < 12; ++i) sigmas(i) = sigma(rng);
+  sigmas(0) = 1e-5;  // no '.' in its shortest form
+  sigmas(1) = 0.0;
+  file.sigmas = sigmas;
+  file.stamp = 1700000000.123456789;
+  return file;
+}
+
+/// The extrinsics a reader gets back when the file holds exactly e.toParameters().
+void expectSameBits(const StereoExtrinsics& read, const StereoExtrinsics& written) {
+  const StereoExtrinsics expected = StereoExtrinsics::fromParameters(written.toParameters());
+  EXPECT_TRUE(read.T_veh_caml.matrix() == expected.T_veh_caml.matrix());
+  EXPECT_TRUE(read.T_caml_camr.matrix() == expected.T_caml_camr.matrix());
+}
+
+const std::string kValidYaml =
+    "vehicle_to_left: [1.5, 0.25, 1.25, 0.0, 0.125, -0.5]\n"
+    "left_to_right: [0.0, -0.5, 0.0, 0.0, 0.0, 0.0]\n";
+
+// ---------------------------------------------------------------------------------------
+// Calibration YAML
+// ---------------------------------------------------------------------------------------
+
+TEST(CalibrationFile, ParsesTheInterfaceExample) {
+  const CalibrationFile file = parseCalibrationYaml(kValidYaml + "other_key: 3\n", "inline");
+  Vector12d expected;
+  expected << 1.5, 0.25, 1.25, 0.0, 0.125, -0.5, 0.0, -0.5, 0.0, 0.0, 0.0, 0.0;
+  EXPECT_TRUE(file.extrinsics.toParameters().isApprox(expected, 1e-15))
+      << file.extrinsics.toParameters().transpose();
+  EXPECT_NEAR(file.extrinsics.T_caml_camr.translation().y(), -0.5, 0.0);
+  EXPECT_FALSE(file.sigmas.has_value());
+  EXPECT_FALSE(file.stamp.has_value());
+}
+
+TEST(CalibrationFile, AtomicWriteThenReadIsBitExact) {
+  TempDir dir;
+  std::mt19937 rng(42);
+  const CalibrationFile written = sampleCalibration(rng);
+  const std::string path = dir.file("calibration.yaml");
+  writeCalibrationFileAtomic(path, written);
+
+  const CalibrationFile read = readCalibrationFile(path);
+  expectSameBits(read.extrinsics, written.extrinsics);
+  ASSERT_TRUE(read.sigmas.has_value());
+  for (int i = 0; i < 12; ++i) EXPECT_EQ((*read.sigmas)(i), (*written.sigmas)(i)) << i;
+  ASSERT_TRUE(read.stamp.has_value());
+  EXPECT_EQ(*read.stamp, *written.stamp);
+
+  const std::string text = readText(path);
+  EXPECT_EQ(text.rfind("# ", 0), 0u) << "starts with a comment line";
+  EXPECT_NE(text.find("metres and radians"), std::string::npos);
+  EXPECT_NE(text.find("1.0000000000000001e-05"), std::string::npos) << text;
+  EXPECT_EQ(dir.entries(), std::set<std::string>({"calibration.yaml"})) << "no temp file left";
+}
+
+TEST(CalibrationFile, FormattedTextParsesBackBitExactForManyValues) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    CalibrationFile written = sampleCalibration(rng);
+    (*written.sigmas)(2) = 1e20;  // formatted as 1.0e+20 (a float to YAML 1.1 readers too)
+    (*written.sigmas)(3) = 5e-324;
+    written.stamp = std::uniform_real_distribution<double>(0.0, 2e9)(rng);
+    const std::string text = formatCalibrationYaml(written);
+    const CalibrationFile read = parseCalibrationYaml(text, "trial");
+    expectSameBits(read.extrinsics, written.extrinsics);
+    ASSERT_TRUE(read.sigmas && read.stamp);
+    EXPECT_TRUE(*read.sigmas == *written.sigmas) << text;
+    EXPECT_EQ(*read.stamp, *written.stamp) << text;
+    ASSERT_NE(text.find("1.0e+20"), std::string::npos) << text;
+  }
+}
+
+TEST(CalibrationFile, MissingKeyIsNamed) {
+  expectThrowMentioning<std::runtime_error>(
+      [] { parseCalibrationYaml("vehicle_to_left: [1, 2, 3, 4, 5, 6]\n", "guess.yaml"); },
+      {"guess.yaml", "missing", "left_to_right"});
+  expectThrowMentioning<std::runtime_error>(
+      [] { parseCalibrationYaml("left_to_right: [1, 2, 3, 4, 5, 6]\n", "guess.yaml"); },
+      {"guess.yaml", "missing", "vehicle_to_left"});
+}
+
+TEST(CalibrationFile, WrongLengthIsNamed) {
+  expectThrowMentioning<std::runtime_error>(
+      [] {
+        parseCalibrationYaml("vehicle_to_left: [1, 2, 3]\nleft_to_right: [1, 2, 3, 4, 5, 6]\n",
+                             "short.yaml");
+      },
+      {"short.yaml", "vehicle_to_left", "6"});
+  expectThrowMentioning<std::runtime_error>(
+      [] {
+        parseCalibrationYaml(
+            "vehicle_to_left: [1, 2, 3, 4, 5, 6]\nleft_to_right: [1, 2, 3, 4, 5, 6, 7]\n",
+            "long.yaml");
+      },
+      {"long.yaml", "left_to_right"});
+  expectThrowMentioning<std::runtime_error>(
+      [] {
+        parseCalibrationYaml("vehicle_to_left: 1.0\nleft_to_right: [1, 2, 3, 4, 5, 6]\n", "s");
+      },
+      {"vehicle_to_left"});
+}
+
+TEST(CalibrationFile, NanAndNonNumbersAreNamed) {
+  expectThrowMentioning<std::runtime_error>(
+      [] {
+        parseCalibrationYaml(
+            "vehicle_to_left: [1, 2, 3, 4, 5, 6]\nleft_to_right: [0, 0, .nan, 0, 0, 0]\n",
+            "nan.yaml");
+      },
+      {"nan.yaml", "left_to_right[2]", "NaN"});
+  expectThrowMentioning<std::runtime_error>(
+      [] {
+        parseCalibrationYaml(
+            "vehicle_to_left: [1, 2, 3, abc, 5, 6]\nleft_to_right: [0, 0, 0, 0, 0, 0]\n",
+            "word.yaml");
+      },
+      {"word.yaml", "vehicle_to_left[3]", "not a number"});
+  expectThrowMentioning<std::runtime_error>(
+      [] { parseCalibrationYaml(kValidYaml + "stamp: .inf\n", "stamp.yaml"); },
+      {"stamp.yaml", "stamp"});
+}
+
+TEST(CalibrationFile, SigmaKeysAreChecked) {
+  expectThrowMentioning<std::runtime_error>(
+      [] { parseCalibrationYaml(kValidYaml + "sigma_vehicle_to_left: [1, 1, 1, 1, 1, 1]\n", "a"); },
+      {"missing", "sigma_left_to_right"});
+  expectThrowMentioning<std::runtime_error>(
+      [] {
+        parseCalibrationYaml(kValidYaml +
+                                 "sigma_vehicle_to_left: [1, 1, 1, 1, 1, 1]\n"
+                                 "sigma_left_to_right: [1, 1, 1, 1, -1, 1]\n",
+                             "b");
+      },
+      {"sigma_left_to_right[4]", "negative"});
+}
+
+TEST(CalibrationFile, BadYamlAndMissingFileNameTheSource) {
+  expectThrowMentioning<std::runtime_error>(
+      [] { parseCalibrationYaml("vehicle_to_left: [1, 2\n", "broken.yaml"); }, {"broken.yaml"});
+  expectThrowMentioning<std::runtime_error>([] { parseCalibrationYaml("- 1\n- 2\n", "list.yaml"); },
+                                            {"list.yaml"});
+  expectThrowMentioning<std::runtime_error>(
+      [] { readCalibrationFile("/nonexistent/dir/calib.yaml"); }, {"/nonexistent/dir/calib.yaml"});
+}
+
+TEST(CalibrationFile, OverwriteReplacesTheOldContents) {
+  TempDir dir;
+  std::mt19937 rng(3);
+  const std::string path = dir.file("result.yaml");
+  writeCalibrationFileAtomic(path, sampleCalibration(rng));
+  const CalibrationFile second = sampleCalibration(rng);
+  writeCalibrationFileAtomic(path, second);
+  expectSameBits(readCalibrationFile(path).extrinsics, second.extrinsics);
+  EXPECT_EQ(dir.entries().size(), 1u);
+}
+
+TEST(CalibrationFile, WriteIntoMissingDirectoryFailsCleanly) {
+  TempDir dir;
+  const std::string path = dir.file("no_such_dir/result.yaml");
+  std::mt19937 rng(4);
+  expectThrowMentioning<std::runtime_error>(
+      [&] { writeCalibrationFileAtomic(path, sampleCalibration(rng)); }, {path});
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(CalibrationFile, NonFiniteValuesAreRefusedAndOldFileKept) {
+  TempDir dir;
+  const std::string path = dir.file("result.yaml");
+  writeText(path, kValidYaml);
+  std::mt19937 rng(5);
+  CalibrationFile bad = sampleCalibration(rng);
+  (*bad.sigmas)(4) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(writeCalibrationFileAtomic(path, bad), std::runtime_error);
+  EXPECT_EQ(readText(path), kValidYaml);
+  EXPECT_EQ(dir.entries(), std::set<std::string>({"result.yaml"}));
+}
+
+/// Restores the file size limit and SIGXFSZ disposition on scope exit.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    ::getrlimit(RLIMIT_FSIZE, &saved_);
+    old_handler_ = ::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit = saved_;
+    limit.rlim_cur = bytes;
+    ok_ = ::setrlimit(RLIMIT_FSIZE, &limit) == 0;
+  }
+  ~FileSizeLimit() {
+    ::setrlimit(RLIMIT_FSIZE, &saved_);
+    ::signal(SIGXFSZ, old_handler_);
+  }
+  bool ok() const { return ok_; }
+
+ private:
+  rlimit saved_{};
+  void (*old_handler_)(int) = nullptr;
+  bool ok_ = false;
+};
+
+// A write that fails half-way (file size limit; works as root too) must keep the old file
+// and leave no temporary file behind.
+TEST(CalibrationFile, FailedWriteKeepsOldFileAndLeavesNoTemp) {
+  TempDir dir;
+  const std::string path = dir.file("result.yaml");
+  writeText(path, kValidYaml);
+  std::mt19937 rng(6);
+  const CalibrationFile next = sampleCalibration(rng);
+  {
+    FileSizeLimit limit(64);
+    ASSERT_TRUE(limit.ok());
+    expectThrowMentioning<std::runtime_error>([&] { writeCalibrationFileAtomic(path, next); },
+                                              {path, "write"});
+  }
+  EXPECT_EQ(readText(path), kValidYaml);
+  EXPECT_EQ(dir.entries(), std::set<std::string>({"result.yaml"}));
+}
+
+TEST(CalibrationFile, ReadOnlyDirectoryFailsCleanly) {
+  TempDir dir;
+  const std::string path = dir.file("result.yaml");
+  writeText(path, kValidYaml);
+  ASSERT_EQ(::chmod(dir.path().c_str(), 0555), 0);
+  if (::access(dir.path().c_str(), W_OK) == 0) {
+    GTEST_SKIP() << "running as root: permissions do not stop writes (see the file size test)";
+  }
+  std::mt19937 rng(8);
+  EXPECT_THROW(writeCalibrationFileAtomic(path, sampleCalibration(rng)), std::runtime_error);
+  EXPECT_EQ(readText(path), kValidYaml);
+  EXPECT_EQ(dir.entries(), std::set<std::string>({"result.yaml"}));
+}
+
+// ---------------------------------------------------------------------------------------
+// CSV
+// ---------------------------------------------------------------------------------------
+
+TEST(EstimatesCsv, HeaderIsExactlyTheInterface) {
+  const std::string interface_header =
+      "frame,stamp,xl,yl,zl,roll_l,pitch_l,yaw_l,xr,yr,zr,roll_r,pitch_r,yaw_r,"
+      "sigma_xl,sigma_yl,sigma_zl,sigma_roll_l,sigma_pitch_l,sigma_yaw_l,"
+      "sigma_xr,sigma_yr,sigma_zr,sigma_roll_r,sigma_pitch_r,sigma_yaw_r,tracked_points,time_ms";
+  EXPECT_EQ(estimatesCsvHeader(), interface_header);
+  EXPECT_EQ(referenceCsvHeader(),
+            "frame,stamp,xl,yl,zl,roll_l,pitch_l,yaw_l,xr,yr,zr,roll_r,pitch_r,yaw_r");
+
+  TempDir dir;
+  { EstimatesCsvWriter writer(dir.file("estimates.csv")); }
+  { ReferenceCsvWriter writer(dir.file("reference.csv")); }
+  EXPECT_EQ(readText(dir.file("estimates.csv")), interface_header + "\n");
+  EXPECT_EQ(readText(dir.file("reference.csv")), referenceCsvHeader() + "\n");
+}
+
+TEST(EstimatesCsv, RoundTripIsExact) {
+  TempDir dir;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> positive(1e-9, 1.0);
+  std::vector<EstimateRow> estimates;
+  std::vector<ReferenceRow> reference;
+  for (int frame = 0; frame < 50; ++frame) {
+    EstimateRow row;
+    row.frame = frame;
+    row.stamp = (frame % 2 == 0) ? 1700000000.0 + frame * 0.1 : frame * 0.1;  // 0.1 * 3 etc.
+    row.parameters = randomParameters(rng);
+    for (int i = 0; i < 12; ++i) row.sigmas(i) = positive(rng);
+    row.tracked_points = frame * 3;
+    row.time_ms = positive(rng) * 100.0;
+    estimates.push_back(row);
+    reference.push_back({frame, row.stamp, randomParameters(rng)});
+  }
+  {
+    EstimatesCsvWriter writer(dir.file("estimates.csv"));
+    for (const EstimateRow& row : estimates) writer.write(row);
+    writer.flush();
+    ReferenceCsvWriter reference_writer(dir.file("reference.csv"));
+    for (const ReferenceRow& row : reference) reference_writer.write(row);
+  }
+  const std::vector<EstimateRow> read = readEstimatesCsv(dir.file("estimates.csv"));
+  ASSERT_EQ(read.size(), estimates.size());
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    EXPECT_EQ(read[i].frame, estimates[i].frame);
+    EXPECT_EQ(read[i].stamp, estimates[i].stamp) << i;
+    EXPECT_TRUE(read[i].parameters == estimates[i].parameters) << i;
+    EXPECT_TRUE(read[i].sigmas == estimates[i].sigmas) << i;
+    EXPECT_EQ(read[i].tracked_points, estimates[i].tracked_points);
+    EXPECT_EQ(read[i].time_ms, estimates[i].time_ms);
+  }
+  const std::vector<ReferenceRow> read_reference = readReferenceCsv(dir.file("reference.csv"));
+  ASSERT_EQ(read_reference.size(), reference.size());
+  for (std::size_t i = 0; i < reference.size(); ++i) {
+    EXPECT_EQ(read_reference[i].frame, reference[i].frame);
+    EXPECT_EQ(read_reference[i].stamp, reference[i].stamp);
+    EXPECT_TRUE(read_reference[i].parameters == reference[i].parameters) << i;
+  }
+
+  // Every stamp has at least nanosecond digits.
+  std::istringstream lines(readText(dir.file("estimates.csv")));
+  std::string line;
+  std::getline(lines, line);
+  while (std::getline(lines, line)) {
+    const std::string stamp =
+        line.substr(line.find(',') + 1, line.find(',', line.find(',') + 1) - line.find(',') - 1);
+    ASSERT_NE(stamp.find('.'), std::string::npos) << stamp;
+    EXPECT_GE(stamp.size() - stamp.find('.') - 1, 9u) << stamp;
+  }
+}
+
+TEST(EstimatesCsv, ReaderAcceptsExtraColumnsAndNan) {
+  TempDir dir;
+  std::string line = "7,0.700000000";
+  for (int i = 0; i < 24; ++i) line += i == 5 ? ",nan" : ",0.5";
+  line += ",12,3.25,extra\r\n";
+  writeText(dir.file("e.csv"), estimatesCsvHeader() + ",note\r\n" + line + "\n");
+  const std::vector<EstimateRow> rows = readEstimatesCsv(dir.file("e.csv"));
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].frame, 7);
+  EXPECT_TRUE(std::isnan(rows[0].parameters(5)));
+  EXPECT_EQ(rows[0].tracked_points, 12);
+  EXPECT_EQ(rows[0].time_ms, 3.25);
+}
+
+TEST(EstimatesCsv, ReaderRejectsBadHeaderAndBadFields) {
+  TempDir dir;
+  writeText(dir.file("bad_header.csv"), "frame,stamp,xl\n1,2,3\n");
+  expectThrowMentioning<std::runtime_error>([&] { readEstimatesCsv(dir.file("bad_header.csv")); },
+                                            {"bad_header.csv", "header"});
+  std::string row = "1,0.1";
+  for (int i = 0; i < 24; ++i) row += i == 8 ? ",x1" : ",0";
+  row += ",3,1.0\n";
+  writeText(dir.file("bad_field.csv"), estimatesCsvHeader() + "\n" + row);
+  expectThrowMentioning<std::runtime_error>([&] { readEstimatesCsv(dir.file("bad_field.csv")); },
+                                            {"line 2", "'zr'"});
+  writeText(dir.file("short.csv"), referenceCsvHeader() + "\n1,2,3\n");
+  expectThrowMentioning<std::runtime_error>([&] { readReferenceCsv(dir.file("short.csv")); },
+                                            {"short.csv", "line 2"});
+  EXPECT_THROW(EstimatesCsvWriter(dir.file("missing/e.csv")), std::runtime_error);
+  EXPECT_THROW(readReferenceCsv(dir.file("missing.csv")), std::runtime_error);
+}
+
+// ---------------------------------------------------------------------------------------
+// Evaluation
+// ---------------------------------------------------------------------------------------
+
+EstimateRow estimate(int frame, const Vector12d& parameters, double sigma) {
+  EstimateRow row;
+  row.frame = frame;
+  row.parameters = parameters;
+  row.sigmas = Vector12d::Constant(sigma);
+  return row;
+}
+
+ReferenceRow truth(int frame, const Vector12d& parameters) { return {frame, 0.0, parameters}; }
+
+TEST(Evaluation, RmseAndConsistencyMatchAHandComputation) {
+  Vector12d ref = Vector12d::Zero();
+  ref(7) = -0.5;  // yr
+  std::vector<ReferenceRow> reference;
+  for (int f = 0; f <= 12; ++f) reference.push_back(truth(f, ref));
+  reference.erase(reference.begin() + 11);  // frame 11 has no reference
+
+  // xl errors 0.1, -0.3, 0.2 on frames 10, 12, 9 (given out of order); sigma 0.06 -> 2 sigma
+  // 0.12: only the first is within. yr errors 0.01, 0.01, 0.05 with sigma 0.02: 2 of 3 within.
+  std::vector<EstimateRow> estimates;
+  Vector12d p = ref;
+  p(0) = 0.1, p(7) = -0.49;
+  estimates.push_back(estimate(10, p, 0.06));
+  p(0) = -0.3, p(7) = -0.49;
+  estimates.push_back(estimate(12, p, 0.06));
+  estimates.back().sigmas(7) = 0.02;
+  estimates.back().sigmas(0) = 0.07;
+  p(0) = 0.2, p(7) = -0.45;
+  estimates.push_back(estimate(9, p, 0.06));
+  p(0) = 5.0;
+  estimates.push_back(estimate(11, p, 0.06));  // no reference: not used
+  estimates.push_back(estimate(3, p, 0.06));   // outside the window
+  for (EstimateRow& row : estimates) row.sigmas(7) = 0.02;
+
+  const EvaluationReport report = evaluateWindow(estimates, reference, 9, 12);
+  EXPECT_EQ(report.first_frame, 9);
+  EXPECT_EQ(report.last_frame, 12);
+  EXPECT_EQ(report.frames_used, 3);
+  const ParameterStatistics& xl = report.parameters[0];
+  EXPECT_NEAR(xl.rmse, std::sqrt((0.01 + 0.09 + 0.04) / 3.0), 1e-15);
+  EXPECT_NEAR(xl.within_2sigma, 1.0 / 3.0, 1e-15);
+  EXPECT_NEAR(xl.max_abs_error, 0.3, 1e-15);
+  EXPECT_EQ(xl.sigma_at_last, 0.07);  // frame 12 is the last
+  const ParameterStatistics& yr = report.parameters[7];
+  EXPECT_NEAR(yr.rmse, std::sqrt((0.0001 + 0.0001 + 0.0025) / 3.0), 1e-12);
+  EXPECT_NEAR(yr.within_2sigma, 2.0 / 3.0, 1e-15);
+  EXPECT_EQ(report.parameters[1].rmse, 0.0);
+  EXPECT_EQ(report.parameters[1].within_2sigma, 1.0);
+
+  // Diagonal NEES by hand: per frame sum_k (e_k / sigma_k)^2 / 12.
+  const double nees_10 = (std::pow(0.1 / 0.06, 2) + std::pow(0.01 / 0.02, 2)) / 12.0;
+  const double nees_12 = (std::pow(0.3 / 0.07, 2) + std::pow(0.01 / 0.02, 2)) / 12.0;
+  const double nees_9 = (std::pow(0.2 / 0.06, 2) + std::pow(0.05 / 0.02, 2)) / 12.0;
+  EXPECT_NEAR(report.mean_nees, (nees_10 + nees_12 + nees_9) / 3.0, 1e-9);
+}
+
+TEST(Evaluation, AngleErrorsAreWrapped) {
+  std::vector<ReferenceRow> reference = {truth(0, Vector12d::Zero()), truth(1, Vector12d::Zero())};
+  reference[1].parameters(11) = -179.0 * kDeg;  // yaw_r
+  Vector12d p0 = Vector12d::Zero();
+  p0(5) = 359.0 * kDeg;  // yaw_l: error -1 deg, not 359 deg
+  p0(11) = 0.0;
+  Vector12d p1 = p0;
+  p1(5) = -359.0 * kDeg;  // error +1 deg
+  p1(11) = 179.0 * kDeg;  // error -2 deg, not 358 deg
+  const EvaluationReport report =
+      evaluateWindow({estimate(0, p0, 1.0), estimate(1, p1, 1.0)}, reference, 0, 1);
+  EXPECT_NEAR(report.parameters[5].rmse, 1.0 * kDeg, 1e-12);
+  EXPECT_NEAR(report.parameters[5].max_abs_error, 1.0 * kDeg, 1e-12);
+  EXPECT_NEAR(report.parameters[11].rmse, std::sqrt(4.0 / 2.0) * kDeg, 1e-12);
+  EXPECT_NEAR(report.parameters[11].max_abs_error, 2.0 * kDeg, 1e-12);
+  // Translations are not wrapped.
+  p0(0) = 2.0 * M_PI;
+  EXPECT_NEAR(evaluateWindow({estimate(0, p0, 1.0)}, reference, 0, 0).parameters[0].rmse,
+              2.0 * M_PI, 1e-12);
+}
+
+TEST(Evaluation, EmptyWindowAndDuplicatesThrow) {
+  const std::vector<ReferenceRow> reference = {truth(0, Vector12d::Zero())};
+  const std::vector<EstimateRow> estimates = {estimate(0, Vector12d::Zero(), 1.0)};
+  EXPECT_THROW(evaluateWindow(estimates, reference, 1, 5), std::invalid_argument);
+  EXPECT_THROW(evaluateWindow(estimates, reference, 1, 0), std::invalid_argument);
+  EXPECT_THROW(evaluateWindow(estimates, {}, 0, 5), std::invalid_argument);
+  EXPECT_THROW(evaluateWindow({estimates[0], estimates[0]}, reference, 0, 0),
+               std::invalid_argument);
+  EXPECT_THROW(evaluateWindow(estimates, {reference[0], reference[0]}, 0, 0),
+               std::invalid_argument);
+}
+
+TEST(Evaluation, FramesToConverge) {
+  const std::vector<double> xl_errors = {5, 4, 0.5, 3, 0.5, 0.4, 0.3, 0.2, 0.1, 0.05};
+  std::vector<EstimateRow> estimates;
+  std::vector<ReferenceRow> reference;
+  for (int f = 0; f < static_cast<int>(xl_errors.size()); ++f) {
+    Vector12d p = Vector12d::Zero();
+    p(0) = xl_errors[f];
+    p(3) = 2.0 * M_PI - 0.01;  // roll_l: wrapped error -0.01
+    estimates.push_back(estimate(f, p, 1.0));
+    reference.push_back(truth(f, Vector12d::Zero()));
+  }
+  EXPECT_EQ(framesToConverge(estimates, reference, 0, 1.0, 0), 4);
+  EXPECT_EQ(framesToConverge(estimates, reference, 0, 1.0, 6), 6);
+  EXPECT_EQ(framesToConverge(estimates, reference, 0, 0.35, 0), 6);
+  EXPECT_EQ(framesToConverge(estimates, reference, 0, 10.0, 0), 0);
+  EXPECT_EQ(framesToConverge(estimates, reference, 0, 0.01, 0), -1);
+  EXPECT_EQ(framesToConverge(estimates, reference, 3, 0.02, 0), 0);
+  EXPECT_EQ(framesToConverge(estimates, reference, 0, 1.0, 100), -1);
+
+  estimates[7].parameters(0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(framesToConverge(estimates, reference, 0, 1.0, 0), 8);
+  EXPECT_THROW(framesToConverge(estimates, reference, 12, 1.0, 0), std::invalid_argument);
+}
+
+TEST(Evaluation, PaperTableAndFormatting) {
+  EXPECT_DOUBLE_EQ(paperTableRmse()[0], 0.0608);
+  EXPECT_DOUBLE_EQ(paperTableRmse()[4], 0.7061 * kDeg);
+  EXPECT_DOUBLE_EQ(paperTableRmse()[11], 0.0193 * kDeg);
+  EXPECT_DOUBLE_EQ(paperTableSigma()[7], 0.0013);
+  EXPECT_DOUBLE_EQ(paperTableSigma()[9], 0.0100 * kDeg);
+
+  EvaluationReport report;
+  report.first_frame = 1000;
+  report.last_frame = 1150;
+  report.frames_used = 151;
+  for (int k = 0; k < 12; ++k) report.parameters[k].rmse = paperTableRmse()[k] * 0.5;
+  report.parameters[4].rmse = paperTableRmse()[4] * 2.0;  // pitch_l worse than the paper
+  const std::string table = formatTableI(report);
+  EXPECT_NE(table.find("1000..1150"), std::string::npos) << table;
+  EXPECT_NE(table.find("151 used"), std::string::npos) << table;
+  // pitch_l: ours 1.4122 deg, paper 0.7061 deg, not below.
+  const std::size_t pitch = table.find("pitch_l");
+  ASSERT_NE(pitch, std::string::npos);
+  const std::string pitch_line = table.substr(pitch, table.find('|', pitch) - pitch);
+  EXPECT_NE(pitch_line.find("1.41220"), std::string::npos) << pitch_line;
+  EXPECT_NE(pitch_line.find("0.70610"), std::string::npos) << pitch_line;
+  EXPECT_NE(pitch_line.find(" no"), std::string::npos) << pitch_line;
+  const std::size_t xl = table.find("xl ");
+  ASSERT_NE(xl, std::string::npos);
+  EXPECT_NE(table.substr(xl, table.find('|', xl) - xl).find(" yes"), std::string::npos) << table;
+}
+
+}  // namespace
+}  // namespace osc
