@@ -291,18 +291,19 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
 
   // ---- Kalman update of the global block with the points marginalised ----
   // Each residual r_i = J_i dg + n_i, n_i ~ N(0, S0_i) independent given g, so the update
-  // is a sequence of small exact updates (Joseph form for numerical symmetry).
+  // is a sequence of small exact updates: P -= K S K^T (O(G^2) each; P is symmetrised and
+  // checked for positive definiteness once at the end, see repairCovariance()).
   VectorXd dg = VectorXd::Zero(G);
-  const MatrixXd identity = MatrixXd::Identity(G, G);
   double nis_sum = 0.0;
   for (const PointInnovation* inn : used) {
-    const Eigen::Matrix4d S = inn->J * P * inn->J.transpose() + inn->S0;
-    const MatrixXd K = P * inn->J.transpose() * S.inverse();
+    const MatrixXd PJt = P * inn->J.transpose();
+    const Eigen::Matrix4d S = inn->J * PJt + inn->S0;
+    const MatrixXd K = PJt * S.inverse();
     dg += K * (inn->residual - inn->J * dg);
-    const MatrixXd IKJ = identity - K * inn->J;
-    P = IKJ * P * IKJ.transpose() + K * inn->S0 * K.transpose();
+    P.noalias() -= K * PJt.transpose();
     nis_sum += inn->nis;
   }
+  P = 0.5 * (P + P.transpose());
   report.measurements_used = static_cast<int>(used.size());
   report.mean_nis = used.empty() ? 0.0 : nis_sum / used.size();
 
