@@ -1284,6 +1284,17 @@ TEST(StereoGeometry, TriangulateMidpointRejectsParallelRays) {
   }
   EXPECT_FALSE(
       triangulateMidpoint(Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 1), rig.T_lopt_ropt));
+  // Converging but only 1e-7 rad apart (a point ~1200 km away with a 12 cm baseline): nearly
+  // parallel, rejected; 1e-4 rad apart (1.2 km) is still a valid point.
+  StereoRig horizontal;
+  horizontal.T_lopt_ropt.translation() = Eigen::Vector3d(0.12, 0, 0);
+  EXPECT_FALSE(triangulateMidpoint(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(-1e-7, 0, 1),
+                                   horizontal.T_lopt_ropt));
+  const auto far = triangulateMidpoint(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(-1e-4, 0, 1),
+                                       horizontal.T_lopt_ropt);
+  ASSERT_TRUE(far.has_value());
+  EXPECT_NEAR(far->point_left.z(), 0.12 / 1e-4, 1e-6 * 1200);
+  EXPECT_NEAR(far->parallax, 1e-4, 1e-10);
 }
 
 TEST(StereoGeometry, TriangulateMidpointRejectsPointsBehindTheCameras) {
@@ -1299,6 +1310,11 @@ TEST(StereoGeometry, TriangulateMidpointRejectsPointsBehindTheCameras) {
     // Forward-pointing rays whose lines meet behind the cameras.
     EXPECT_FALSE(triangulateMidpoint(-behind, -(T_ropt_lopt * behind), rig.T_lopt_ropt))
         << behind.transpose();
+    // Lines meeting at a point in front of the left camera, but against the direction of one
+    // ray: the right ray points away from it, or the left one does.
+    const Eigen::Vector3d in_right = T_ropt_lopt * front;
+    EXPECT_FALSE(triangulateMidpoint(front, -in_right, rig.T_lopt_ropt)) << front.transpose();
+    EXPECT_FALSE(triangulateMidpoint(-front, in_right, rig.T_lopt_ropt)) << front.transpose();
   }
   // Diverging rays: left looks slightly left, right slightly right; the lines cross behind.
   StereoRig horizontal;
