@@ -276,3 +276,32 @@ TEST_F(FilterWithPoints, ResetRejectsAnIndefiniteCovariance) {
 
 }  // namespace
 }  // namespace osc
+
+namespace osc {
+namespace {
+
+TEST_F(FilterWithPoints, PredictedObservationsBracketTheMeasurementAndLeaveTheFilterAlone) {
+  const CalibrationFilter before = filter;
+  const auto predictions = filter.predictObservations(problem.motion(4));
+  expectUntouched(before);
+  ASSERT_EQ(predictions.size(), filter.pointCount());
+  const auto measurements = problem.measure(4, 0.5);
+  int inside = 0;
+  for (const PredictedObservation& p : predictions) {
+    const Eigen::Vector4d r = measurements[p.id - 1].z - p.z;
+    EXPECT_TRUE(p.S.isApprox(p.S.transpose(), 1e-9));
+    if (r.dot(p.S.llt().solve(r)) < 18.47) ++inside;  // chi-square(4), 99.9 %
+  }
+  EXPECT_GE(inside, static_cast<int>(predictions.size()) - 1);
+  // Against a deliberately wrong motion the predictions must move away.
+  MotionIncrement wrong = problem.motion(4);
+  wrong.T_prev_curr.translation().x() += 0.5;
+  const auto off = filter.predictObservations(wrong);
+  EXPECT_GT((off.front().z - predictions.front().z).norm(), 1.0);
+  MotionIncrement nan_motion = problem.motion(4);
+  nan_motion.dt = std::nan("");
+  EXPECT_TRUE(filter.predictObservations(nan_motion).empty());
+}
+
+}  // namespace
+}  // namespace osc

@@ -77,7 +77,9 @@ std::vector<int> range(int first, int count) {
 /// A point's linearised measurement (regression of the UT on [x_camr, p]).
 struct CalibrationFilter::PointInnovation {
   size_t point = 0;
+  Eigen::Vector4d predicted;   ///< predicted measurement z_hat
   Eigen::Vector4d residual;
+  Eigen::Matrix4d S;           ///< full innovation covariance J P J^T + S0
   MatrixXd J;             ///< 4 x G: d residual / d global error (through x_camr and B)
   Eigen::Matrix<double, 4, 3> H_p;  ///< d z / d point
   Eigen::Matrix4d S0;     ///< covariance of the residual given the global error
@@ -203,25 +205,14 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
   report.accepted = true;
 
   // ---- prediction (Sec. II-B) ----
-  applyCalibrationDrift(motion.dt);
   const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
-  const int G = shared ? layout::kAugmentedDim : layout::kCalibrationDim;
-  MatrixXd P = MatrixXd::Zero(G, G);
-  P.topLeftCorner<12, 12>() = covariance_;
-  if (shared) {
-    P.bottomRightCorner<6, 6>() = motionNoiseCovariance(config_, motion.dt);
-    for (TrackedPoint& point : points_) {
-      point.B.conservativeResize(3, G);
-      point.B.rightCols<6>().setZero();
-    }
-  }
-  std::vector<bool> remove(points_.size(), false);
-  predictPoints(motion, P, &remove);
+  std::vector<bool> remove;
+  MatrixXd P = predict(motion, &remove);
+  const int G = static_cast<int>(P.rows());
 
   // ---- linearised measurements of every measured point (Sec. II-C) ----
   std::vector<PointInnovation> innovations;
   std::vector<bool> measured(points_.size(), false);
-  const std::vector<int> camr = range(layout::kCamr, layout::kPoseDim);
   for (const PointMeasurement& m : measurements) {
     if (!m.z.allFinite() || !m.variance.allFinite() || !(m.variance.minCoeff() > 0.0)) {
       ++report.invalid_measurements;
@@ -230,32 +221,11 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
     const auto found = index_.find(m.id);
     if (found == index_.end() || remove[found->second]) continue;
     const size_t i = found->second;
-    TrackedPoint& point = points_[i];
-    const VectorFunction observe = [&](const VectorXd& x, VectorXd* y) {
-      const Eigen::Isometry3d T_ropt_lopt =
-          leftToRightOptical(boxPlus(extrinsics_.T_caml_camr, x.head<6>())).inverse();
-      Eigen::Vector4d z;
-      if (!projectStereo(point.mean + x.tail<3>(), T_ropt_lopt, intrinsics_, 1e-3, &z)) return false;
-      *y = z;
-      return true;
-    };
-    UnscentedResult ut;
-    if (!unscentedTransformWithFallback(VectorXd::Zero(9), jointCovariance(P, camr, point.B, point.D),
-                                        observe, ut_, &ut)) {
+    PointInnovation inn;
+    if (!linearizeMeasurement(i, P, m.z, m.variance, &inn)) {
       continue;  // behind a camera for some sigma point: not measurable, dropped below
     }
     measured[i] = true;
-    PointInnovation inn;
-    inn.point = i;
-    inn.residual = m.z - ut.mean;
-    inn.H_p = ut.jacobian.rightCols<3>();
-    inn.J = inn.H_p * point.B;
-    for (int a = 0; a < 6; ++a) inn.J.col(camr[a]) += ut.jacobian.col(a);
-    inn.S0 = inn.H_p * point.D * inn.H_p.transpose() + ut.residual;
-    inn.S0.diagonal() += m.variance;
-    const Eigen::Matrix4d S = inn.J * P * inn.J.transpose() + inn.S0;
-    inn.nis = inn.residual.dot(S.llt().solve(inn.residual));
-    inn.nis_left = inn.residual.head<2>().dot(S.topLeftCorner<2, 2>().llt().solve(inn.residual.head<2>()));
     innovations.push_back(inn);
   }
 
@@ -337,6 +307,82 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
   removeIndices(remove);
   if (innovations.empty()) report.message = "no usable measurements: prediction only";
   return report;
+}
+
+MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<bool>* failed) {
+  applyCalibrationDrift(motion.dt);
+  const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
+  const int G = shared ? layout::kAugmentedDim : layout::kCalibrationDim;
+  MatrixXd P = MatrixXd::Zero(G, G);
+  P.topLeftCorner<12, 12>() = covariance_;
+  if (shared) {
+    P.bottomRightCorner<6, 6>() = motionNoiseCovariance(config_, motion.dt);
+    for (TrackedPoint& point : points_) {
+      point.B.conservativeResize(3, G);
+      point.B.rightCols<6>().setZero();
+    }
+  }
+  failed->assign(points_.size(), false);
+  predictPoints(motion, P, failed);
+  return P;
+}
+
+bool CalibrationFilter::linearizeMeasurement(size_t i, const MatrixXd& P, const Eigen::Vector4d& z,
+                                             const Eigen::Vector4d& variance,
+                                             PointInnovation* inn) const {
+  // Seed eq. 29-30 through a UT on [x_camr, p], as a regression on the global error.
+  const TrackedPoint& point = points_[i];
+  const std::vector<int> camr = range(layout::kCamr, layout::kPoseDim);
+  const VectorFunction observe = [&](const VectorXd& x, VectorXd* y) {
+    const Eigen::Isometry3d T_ropt_lopt =
+        leftToRightOptical(boxPlus(extrinsics_.T_caml_camr, x.head<6>())).inverse();
+    Eigen::Vector4d projected;
+    if (!projectStereo(point.mean + x.tail<3>(), T_ropt_lopt, intrinsics_, 1e-3, &projected)) return false;
+    *y = projected;
+    return true;
+  };
+  UnscentedResult ut;
+  if (!unscentedTransformWithFallback(VectorXd::Zero(9), jointCovariance(P, camr, point.B, point.D),
+                                      observe, ut_, &ut)) {
+    return false;
+  }
+  inn->point = i;
+  inn->predicted = ut.mean;
+  inn->residual = z - ut.mean;
+  inn->H_p = ut.jacobian.rightCols<3>();
+  inn->J = inn->H_p * point.B;
+  for (int a = 0; a < 6; ++a) inn->J.col(camr[a]) += ut.jacobian.col(a);
+  inn->S0 = inn->H_p * point.D * inn->H_p.transpose() + ut.residual;
+  inn->S0.diagonal() += variance;
+  inn->S = inn->J * P * inn->J.transpose() + inn->S0;
+  if (z.allFinite()) {
+    inn->nis = inn->residual.dot(inn->S.llt().solve(inn->residual));
+    inn->nis_left =
+        inn->residual.head<2>().dot(inn->S.topLeftCorner<2, 2>().llt().solve(inn->residual.head<2>()));
+  }
+  return true;
+}
+
+std::vector<PredictedObservation> CalibrationFilter::predictObservations(
+    const MotionIncrement& motion) const {
+  std::vector<PredictedObservation> predictions;
+  if (!checkMotion(motion).empty()) return predictions;
+  CalibrationFilter scratch = *this;  // the prediction must not touch this filter
+  std::vector<bool> failed;
+  const MatrixXd P = scratch.predict(motion, &failed);
+  const double v = config_.pixel_noise * config_.pixel_noise;
+  const Eigen::Vector4d variance(v, v, v, v);
+  const Eigen::Vector4d unknown = Eigen::Vector4d::Constant(std::nan(""));
+  for (size_t i = 0; i < scratch.points_.size(); ++i) {
+    PointInnovation inn;
+    if (failed[i] || !scratch.linearizeMeasurement(i, P, unknown, variance, &inn)) continue;
+    PredictedObservation prediction;
+    prediction.id = scratch.points_[i].id;
+    prediction.z = inn.predicted;
+    prediction.S = inn.S;
+    predictions.push_back(prediction);
+  }
+  return predictions;
 }
 
 void CalibrationFilter::marginalizeMotionError(const MatrixXd& P) {

@@ -41,6 +41,13 @@ struct PointEstimate {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();     ///< marginal covariance
 };
 
+/// Where a tracked point is expected in the next image pair, before it is measured.
+struct PredictedObservation {
+  PointId id = 0;
+  Eigen::Vector4d z = Eigen::Vector4d::Zero();  ///< predicted [u_l, v_l, u_r, v_r], undistorted px
+  Eigen::Matrix4d S = Eigen::Matrix4d::Identity();  ///< innovation covariance (px^2), incl. pixel noise
+};
+
 /// Which calibration block a detected sudden change was attributed to.
 enum class JumpBlock { kNone, kVehicleToLeft, kLeftToRight };
 
@@ -74,6 +81,11 @@ class CalibrationFilter {
   /// are outliers. A rejected motion leaves the filter untouched (report.accepted false).
   StepReport step(const MotionIncrement& motion, const std::vector<PointMeasurement>& measurements);
 
+  /// Where each tracked point will be seen after the motion, with its innovation
+  /// covariance (for the tracker's search windows, Sec. II-C). The filter is not changed.
+  /// Empty if the motion is unusable.
+  std::vector<PredictedObservation> predictObservations(const MotionIncrement& motion) const;
+
   /// Triangulates a new point with a scaled UT over x_camr and both pixels' noise and
   /// adds it with its covariance and its cross-covariance with the calibration (Sec. II-A).
   /// False (and nothing added) if the rays do not meet within the depth range.
@@ -105,6 +117,11 @@ class CalibrationFilter {
   struct PointInnovation;  // defined in the .cpp
 
   std::string checkMotion(const MotionIncrement& motion) const;
+  /// Drift, motion-error augmentation and point prediction; returns the global covariance
+  /// (12, or 18 with the step's motion error) and marks points that could not be predicted.
+  Eigen::MatrixXd predict(const MotionIncrement& motion, std::vector<bool>* failed);
+  bool linearizeMeasurement(size_t index, const Eigen::MatrixXd& P, const Eigen::Vector4d& z,
+                            const Eigen::Vector4d& variance, PointInnovation* innovation) const;
   void applyCalibrationDrift(double dt);
   void predictPoints(const MotionIncrement& motion, const Eigen::MatrixXd& P_global,
                      std::vector<bool>* failed);
