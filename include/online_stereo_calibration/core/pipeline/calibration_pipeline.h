@@ -1,0 +1,80 @@
+/// @file calibration_pipeline.h
+/// @brief Images in, calibration out: the image front end (detection, epipolar-guided
+/// stereo matching, bucketing, tracking; seed Sec. II-A and II-C) feeding the estimator.
+/// The one entry point for the ROS nodelet and the offline bag evaluator.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "online_stereo_calibration/core/config/filter_config.h"
+#include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
+#include "online_stereo_calibration/core/frontend/front_end_config.h"
+
+namespace osc {
+
+class StereoFrontEnd;
+
+/// Counts of what the front end did with one image pair.
+struct FrontEndStatistics {
+  int features_left = 0;      ///< keypoints detected in the left image
+  int features_right = 0;     ///< keypoints detected in the right image
+  int stereo_matches = 0;     ///< epipolar-guided matches before bucketing
+  int new_candidates = 0;     ///< matches kept by bucketing and offered as new points
+  int tracked = 0;            ///< tracked points found again in both images
+  int track_failures = 0;     ///< tracked points not found (then removed, Sec. II-C)
+};
+
+/// What processing one image pair produced.
+struct PipelineResult {
+  /// False if the pair was not used (bad image, unsupported encoding, size mismatch...);
+  /// the estimator is then untouched and status says why.
+  bool processed = false;
+  std::string status;
+  FrameReport estimator;        ///< the estimator's report (valid if processed)
+  FrontEndStatistics front_end;
+  CalibrationEstimate estimate; ///< the estimate after this pair
+  double processing_time = 0.0; ///< seconds spent on this pair (front end + filter)
+};
+
+/// The image pipeline. Not thread-safe: call from one thread.
+class CalibrationPipeline {
+ public:
+  /// @throws std::invalid_argument naming the bad config value or camera field.
+  CalibrationPipeline(const FilterConfig& filter_config, const FrontEndConfig& front_end_config,
+                      const CameraIntrinsics& left, const CameraIntrinsics& right,
+                      const StereoExtrinsics& initial_guess);
+  ~CalibrationPipeline();
+  CalibrationPipeline(const CalibrationPipeline&) = delete;
+  CalibrationPipeline& operator=(const CalibrationPipeline&) = delete;
+
+  /// Processes one synchronized stereo pair. Images: CV_8UC1, CV_16UC1, CV_8UC3 (BGR) or
+  /// CV_8UC4 (BGRA), raw (distorted, as the camera models say) or rectified; the sizes must
+  /// match the camera intrinsics. motion_since_previous is ignored for the first pair.
+  PipelineResult process(const cv::Mat& left, const cv::Mat& right,
+                         const MotionIncrement& motion_since_previous);
+
+  /// Forgets all tracks (e.g. time jumped back); the calibration is kept.
+  void resetTracking();
+  /// Starts over from a guess (config's initial sigmas) or from a saved covariance.
+  void reset(const StereoExtrinsics& guess);
+  void reset(const StereoExtrinsics& guess, const Matrix12d& tangent_covariance);
+
+  CalibrationEstimate estimate() const;
+  /// Tracked points in the left optical frame with their covariances.
+  std::vector<PointEstimate> points() const;
+  /// The last processed pair drawn side by side (BGR): tracks, new matches, search windows
+  /// and epipolar bands. Rendering costs time: only call it when someone looks.
+  cv::Mat debugImage() const;
+
+  const StereoCalibrationEstimator& estimator() const;
+
+ private:
+  std::unique_ptr<StereoCalibrationEstimator> estimator_;
+  std::unique_ptr<StereoFrontEnd> front_end_;
+};
+
+}  // namespace osc
