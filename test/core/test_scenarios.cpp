@@ -56,10 +56,11 @@ TEST(PaperScenario, BeatsTableIAndIsNotOverconfident) {
 }
 
 /// Runs a short drive without step and returns the last frame.
-ScenarioFrameResult lastFrame(MeasurementScenario scenario, int frames) {
+ScenarioFrameResult lastFrame(MeasurementScenario scenario, int frames,
+                              const FilterConfig& config = FilterConfig()) {
   scenario.frames = frames;
   scenario.step_frame = -1;
-  const auto results = runMeasurementScenario(scenario, FilterConfig());
+  const auto results = runMeasurementScenario(scenario, config);
   return results.back();
 }
 
@@ -101,6 +102,10 @@ TEST(Observability, CameraHeightNeedsRollOrPitch) {
   EXPECT_LT(r.sigmas(2), 0.1 * initial_sigma);
   EXPECT_GT(p.sigmas(2), 0.3 * initial_sigma);
   EXPECT_GT(p.sigmas(2), 10.0 * r.sigmas(2));
+  // Re-linearising each step at the corrected motion fakes less information.
+  FilterConfig relinearized;
+  relinearized.motion_relinearizations = 1;
+  EXPECT_GT(lastFrame(planar, 300, relinearized).sigmas(2), 1.2 * p.sigmas(2));
   EXPECT_LT(p.sigmas(0), 0.2 * initial_sigma);   // xl is learned either way
   EXPECT_LT(std::abs(p.parameters(2) - p.truth(2)), 3.0 * p.sigmas(2));  // and honest
 }

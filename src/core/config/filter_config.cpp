@@ -69,6 +69,8 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "sigma_IMU: error of the measured vehicle rotation per axis per step (eq. 15)"),
       real("motion_translation_noise_m", &C::motion_translation_noise, 1.0, 0.0, 10.0,
            "error of the measured vehicle translation per axis per step (shared model)"),
+      integer("motion_relinearizations", &C::motion_relinearizations, 0, 5,
+              "shared model: repeat the step linearised at the corrected motion (0 = off)"),
       real("pixel_noise_px", &C::pixel_noise, 1.0, 1e-3, 100.0,
            "default standard deviation of a feature position"),
       real("outlier_gate", &C::outlier_gate, 1.0, 1.0, 1e6,

@@ -202,8 +202,41 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
   StepReport report;
   report.message = checkMotion(motion);
   if (!report.message.empty()) return report;  // untouched
-  report.accepted = true;
 
+  // The prediction is linearised at the measured motion. With the shared motion-noise model
+  // the step's motion error is estimated with the calibration; the step is then repeated,
+  // linearised at the corrected motion (an iterated UKF in the motion error), so the noise of
+  // the measured motion is not mistaken for excitation (e.g. roll noise making zl look
+  // observable on a flat road, seed Sec. II-D).
+  const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
+  const int passes = shared ? 1 + config_.motion_relinearizations : 1;
+  const std::vector<TrackedPoint> saved_points = passes > 1 ? points_ : std::vector<TrackedPoint>();
+  const Matrix12d saved_covariance = covariance_;
+  MotionIncrement linearization = motion;
+  Vector6d prior_motion_error = Vector6d::Zero();
+  for (int pass = 0; pass < passes; ++pass) {
+    if (pass > 0) {
+      points_ = saved_points;
+      covariance_ = saved_covariance;
+      report = StepReport();
+    }
+    Vector6d estimated_motion_error;
+    const bool final_pass = pass + 1 == passes;
+    const bool completed = runPass(linearization, prior_motion_error, measurements, final_pass,
+                                   pass == 0, &report, &estimated_motion_error);
+    if (!completed || final_pass) break;  // a detected jump ends the step
+    // Re-linearise at the corrected motion; the measured motion becomes a prior there.
+    linearization.T_prev_curr = boxPlus(linearization.T_prev_curr, estimated_motion_error);
+    prior_motion_error = boxMinus(motion.T_prev_curr, linearization.T_prev_curr);
+  }
+  report.accepted = true;
+  return report;
+}
+
+bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& prior_motion_error,
+                                const std::vector<PointMeasurement>& measurements, bool final_pass,
+                                bool detect_jump, StepReport* out, Vector6d* motion_error) {
+  StepReport& report = *out;
   // ---- prediction (Sec. II-B) ----
   const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
   std::vector<bool> remove;
@@ -229,6 +262,17 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
     innovations.push_back(inn);
   }
 
+  // With a prior motion error (a re-linearised pass) the innovation is r - J * prior.
+  if (shared && !prior_motion_error.isZero()) {
+    VectorXd prior = VectorXd::Zero(G);
+    prior.tail<6>() = prior_motion_error;
+    for (PointInnovation& inn : innovations) {
+      const Eigen::Vector4d v = inn.residual - inn.J * prior;
+      inn.nis = v.dot(inn.S.llt().solve(v));
+      inn.nis_left = v.head<2>().dot(inn.S.topLeftCorner<2, 2>().llt().solve(v.head<2>()));
+    }
+  }
+
   // ---- gate outliers; many at once means the calibration itself jumped ----
   std::vector<const PointInnovation*> used;
   int left_failures = 0;
@@ -242,7 +286,7 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
     }
   }
   const int tested = static_cast<int>(innovations.size());
-  if (tested >= config_.jump_min_points &&
+  if (detect_jump && tested >= config_.jump_min_points &&
       report.outliers.size() >= config_.jump_rejected_fraction * tested) {
     // The left image does not see x_camr: if it fails too, x_caml moved (via eq. 8).
     report.jump = 2 * left_failures >= static_cast<int>(report.outliers.size())
@@ -256,14 +300,15 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
     points_.clear();
     index_.clear();
     report.message = "sudden calibration change detected; points re-initialised";
-    return report;
+    return false;
   }
 
   // ---- Kalman update of the global block with the points marginalised ----
   // Each residual r_i = J_i dg + n_i, n_i ~ N(0, S0_i) independent given g, so the update
   // is a sequence of small exact updates: P -= K S K^T (O(G^2) each; P is symmetrised and
   // checked for positive definiteness once at the end, see repairCovariance()).
-  VectorXd dg = VectorXd::Zero(G);
+  VectorXd dg = VectorXd::Zero(G);  // prior mean of the global error
+  if (shared) dg.tail<6>() = prior_motion_error;
   double nis_sum = 0.0;
   for (const PointInnovation* inn : used) {
     const MatrixXd PJt = P * inn->J.transpose();
@@ -274,6 +319,8 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
     nis_sum += inn->nis;
   }
   P = 0.5 * (P + P.transpose());
+  *motion_error = shared ? Vector6d(dg.tail<6>()) : Vector6d::Zero();
+  if (!final_pass) return true;
   report.measurements_used = static_cast<int>(used.size());
   report.mean_nis = used.empty() ? 0.0 : nis_sum / used.size();
 
@@ -306,7 +353,7 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
   }
   removeIndices(remove);
   if (innovations.empty()) report.message = "no usable measurements: prediction only";
-  return report;
+  return true;
 }
 
 MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<bool>* failed) {

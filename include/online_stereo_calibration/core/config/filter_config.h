@@ -44,6 +44,10 @@ struct FilterConfig {
   MotionNoiseModel motion_noise_model = MotionNoiseModel::kShared;
   double motion_rotation_noise = 0.02 * 0.0174532925199432958;  ///< rad per axis per step (eq. 15)
   double motion_translation_noise = 0.002;  ///< m per axis per step (shared model only)
+  /// Shared model: repeat each step linearised at the motion corrected by the first pass
+  /// (0 = off). Reduces, but does not remove, the information the motion noise fakes on a
+  /// flat road (zl sigma after 300 frames 0.26 -> 0.37 m of 0.5); doubles the step cost.
+  int motion_relinearizations = 0;
 
   // --- measurements, seed eq. 29-30 ---
   double pixel_noise = 0.5;       ///< px, default sigma of a feature position

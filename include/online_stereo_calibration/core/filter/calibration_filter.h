@@ -117,6 +117,12 @@ class CalibrationFilter {
   struct PointInnovation;  // defined in the .cpp
 
   std::string checkMotion(const MotionIncrement& motion) const;
+  /// One predict + update linearised at `motion` with the given prior mean of the motion
+  /// error; a non-final pass only estimates the motion error. False: a jump was detected
+  /// (the step is complete then).
+  bool runPass(const MotionIncrement& motion, const Vector6d& prior_motion_error,
+               const std::vector<PointMeasurement>& measurements, bool final_pass, bool detect_jump,
+               StepReport* report, Vector6d* motion_error);
   /// Drift, motion-error augmentation and point prediction; returns the global covariance
   /// (12, or 18 with the step's motion error) and marks points that could not be predicted.
   Eigen::MatrixXd predict(const MotionIncrement& motion, std::vector<bool>* failed);

@@ -71,10 +71,16 @@ class CalibrationPipeline {
   cv::Mat debugImage() const;
 
   const StereoCalibrationEstimator& estimator() const;
+  /// The front end, for diagnostics and tests (last pair's tracks, matches, windows).
+  const StereoFrontEnd& frontEnd() const;
 
  private:
   std::unique_ptr<StereoCalibrationEstimator> estimator_;
   std::unique_ptr<StereoFrontEnd> front_end_;
+  /// Motion of skipped (unusable) pairs since the last processed one, composed.
+  MotionIncrement pending_motion_;
+  bool has_pending_motion_ = false;
+  bool processed_any_ = false;
 };
 
 }  // namespace osc

@@ -23,11 +23,11 @@ struct ScenarioFrameResult {
   /// meaningful for any mounting, also where RPY is singular.
   Vector12d tangent_error = Vector12d::Zero();
   Vector12d tangent_sigmas = Vector12d::Zero();  ///< 1 sigma of the tangent error
-  double nees = 0.0;        ///< tangent_error^T P^-1 tangent_error (12 dof)
+  double nees = 0.0;                             ///< tangent_error^T P^-1 tangent_error (12 dof)
   int tracked_points = 0;
   int new_points = 0;
   bool jump_detected = false;
-  double time_ms = 0.0;     ///< estimator time for this frame
+  double time_ms = 0.0;  ///< estimator time for this frame
 };
 
 /// Runs scenario through a StereoCalibrationEstimator starting from the scenario's initial

@@ -1,0 +1,65 @@
+/// @file epipolar_matcher.h
+/// @brief Epipolar-guided stereo matching (seed eq. 5-6) with the current estimate of
+/// x_camr and its uncertainty: candidates in a band around the epipolar line, on the side of
+/// positive disparity, then descriptor threshold, ratio test and one-to-one.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "online_stereo_calibration/core/frontend/feature_detection.h"
+#include "online_stereo_calibration/core/frontend/front_end_config.h"
+#include "online_stereo_calibration/core/geometry/pose.h"
+
+namespace osc {
+
+/// One left-right correspondence (indices into the two FeatureSets).
+struct StereoMatch {
+  int left = -1;
+  int right = -1;
+  double descriptor_distance = 0.0;  ///< normalised, see FrontEndConfig
+  double line_distance = 0.0;        ///< signed distance (px) from the epipolar line
+  double band = 0.0;                 ///< half-width (px) of the band it was accepted in
+};
+
+/// Matches left keypoints to right keypoints along their epipolar lines.
+class EpipolarMatcher {
+ public:
+  /// Depths (m, along the left ray) bounding the search segment on the near side.
+  EpipolarMatcher(const FrontEndConfig& config, double min_depth);
+
+  /// Sets the geometry of this frame: intrinsics, the current x_camr (T_caml_camr, body
+  /// frames) and its 6x6 tangent covariance (the camr block of CalibrationFilter::covariance()).
+  void setGeometry(const Eigen::Matrix3d& K_left, const Eigen::Matrix3d& K_right,
+                   const Eigen::Isometry3d& T_caml_camr, const Matrix6d& camr_covariance);
+
+  /// Half-width (px) of the band for a left undistorted pixel and a right candidate: the
+  /// 1-sigma line distance from x_camr's covariance (numerically through eq. 5-6) and the
+  /// pixel noise of both images, times band_sigmas, clamped to [min_band, max_band].
+  double bandHalfWidth(const Eigen::Vector2d& left, const Eigen::Vector2d& right) const;
+
+  /// Matches in undistorted coordinates. Keypoints flagged in left_used / right_used (may be
+  /// empty) take no part. Each right keypoint is used at most once.
+  std::vector<StereoMatch> match(const FeatureSet& left, const FeatureSet& right,
+                                 const std::vector<char>& left_used,
+                                 const std::vector<char>& right_used) const;
+
+  /// The fundamental matrix of the current estimate (eq. 5).
+  const Eigen::Matrix3d& fundamental() const { return F_; }
+
+ private:
+  FrontEndConfig config_;
+  double min_depth_;
+  Eigen::Matrix3d K_left_inv_ = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d K_right_ = Eigen::Matrix3d::Identity();
+  Eigen::Isometry3d T_ropt_lopt_ = Eigen::Isometry3d::Identity();
+  Eigen::Matrix3d F_ = Eigen::Matrix3d::Identity();
+  /// Per tangent direction j of x_camr: F and T_ropt_lopt perturbed by sqrt(eigenvalue)
+  /// along the j-th eigenvector of the covariance (so the spread is sum of squares).
+  Eigen::Matrix3d F_sigma_[6];
+  Eigen::Isometry3d T_sigma_[6];
+};
+
+}  // namespace osc

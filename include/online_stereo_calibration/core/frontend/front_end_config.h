@@ -1,0 +1,79 @@
+/// @file front_end_config.h
+/// @brief Every tunable of the image front end (seed Sec. II-A, II-C): detection, the
+/// epipolar-guided stereo matching (eq. 5-6), bucketing, new-point checks and tracking.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace osc {
+
+/// The front end's configuration. Units: px, degrees where the name says `_deg`.
+struct FrontEndConfig {
+  // --- detection and description ---
+  /// "ORB" (FAST + ORB pyramid), "FAST_ORB" (FAST on the full image, ORB descriptors on
+  /// one level: fastest), "AKAZE" or "SIFT".
+  std::string detector = "ORB";
+  /// Most keypoints kept per image, [50, 50000].
+  int max_features = 2000;
+  /// FAST threshold (grey levels) of ORB / FAST_ORB, [1, 255].
+  int fast_threshold = 12;
+  /// Pyramid levels of ORB, [1, 16]; scale factor between them, (1, 2].
+  int orb_levels = 4;
+  double orb_scale_factor = 1.2;
+  /// Keypoints are spread over a grid of this many cells per axis (the strongest per cell
+  /// first), [1, 64]. 1 = no spreading.
+  int detection_grid = 8;
+  /// Keypoints closer than this to the image border are ignored (px), [0, 100].
+  double border = 16.0;
+
+  // --- epipolar-guided stereo matching (eq. 5-6) ---
+  /// Half-width of the epipolar band in sigmas of the line distance (x_camr covariance
+  /// propagated to each candidate plus pixel noise), (0, 10].
+  double band_sigmas = 3.0;
+  /// Least half-width of the band (px), [0.1, 50].
+  double min_band = 1.5;
+  /// Largest half-width of the band (px), [min_band, 500]; bounds the search when the
+  /// calibration is very uncertain.
+  double max_band = 60.0;
+  /// Pixel noise (px) per image added to the band, [0, 10].
+  double pixel_sigma = 0.5;
+  /// Largest normalised descriptor distance of a match: Hamming / bits for binary
+  /// descriptors, L2 / sqrt(|a|^2 + |b|^2) for float ones. (0, 1].
+  double max_descriptor_distance = 0.25;
+  /// Lowe's ratio: best distance < ratio * second best among the candidates, (0, 1].
+  double ratio = 0.8;
+
+  // --- spatial sampling ---
+  /// Bucketing grid (cells per axis) for new points: the best match per cell, and none in a
+  /// cell that already holds a tracked point. [1, 64].
+  int bucket_cols = 12;
+  int bucket_rows = 9;
+  /// At most this many new points offered per frame, [0, 10000].
+  int max_new_points_per_frame = 40;
+  /// No new point within this distance (px, left image) of a tracked one, [0, 200].
+  double min_distance_to_track = 10.0;
+  /// Least angle between the two rays of a new point (deg), [0, 30].
+  double min_parallax_deg = 0.05;
+
+  // --- tracking (Sec. II-C) ---
+  /// Search window half-size in sigmas of the predicted pixel (from S), (0, 10].
+  double track_window_sigmas = 3.0;
+  /// Least and largest half-size of the search window (px).
+  double min_track_window = 3.0;   ///< [0.5, 100]
+  double max_track_window = 40.0;  ///< [min_track_window, 500]
+  /// Largest normalised descriptor distance of a track to its stored descriptor, (0, 1].
+  double max_track_descriptor_distance = 0.3;
+
+  // --- input checks ---
+  /// Least image size (px, each axis) accepted, [8, 10000].
+  int min_image_size = 32;
+  /// Least standard deviation of the grey levels (0-255): below it the image is rejected
+  /// as all black, saturated or uniform. [0, 100].
+  double min_contrast = 2.0;
+
+  /// Every problem found, each naming the field, its value and the allowed range.
+  std::vector<std::string> validate() const;
+};
+
+}  // namespace osc

@@ -1,0 +1,73 @@
+/// @file point_tracker.h
+/// @brief Tracking of the filter's points (seed Sec. II-C): each point is searched only in
+/// a window around its predicted pixel in each image, sized from the filter's innovation
+/// covariance S, and matched against its stored descriptors.
+#pragma once
+
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include "online_stereo_calibration/core/estimator/types.h"
+#include "online_stereo_calibration/core/filter/calibration_filter.h"
+#include "online_stereo_calibration/core/frontend/feature_detection.h"
+#include "online_stereo_calibration/core/frontend/front_end_config.h"
+#include "online_stereo_calibration/core/geometry/camera_model.h"
+
+namespace osc {
+
+/// Where to look for one tracked point in the raw images.
+struct TrackWindow {
+  PointId id = 0;
+  Eigen::Vector2d left_center = Eigen::Vector2d::Zero();  ///< predicted raw pixel
+  Eigen::Vector2d right_center = Eigen::Vector2d::Zero();
+  Eigen::Vector2d left_half = Eigen::Vector2d::Zero();  ///< half-size (px) per axis
+  Eigen::Vector2d right_half = Eigen::Vector2d::Zero();
+};
+
+/// A tracked point found again in both images (indices into the FeatureSets).
+struct TrackMatch {
+  PointId id = 0;
+  int left = -1;
+  int right = -1;
+};
+
+/// Stored descriptors of the tracked points and the window search.
+class PointTracker {
+ public:
+  explicit PointTracker(const FrontEndConfig& config);
+
+  /// Starts tracking a point with the descriptors it was found with.
+  void add(PointId id, const cv::Mat& left_descriptor, const cv::Mat& right_descriptor);
+  void remove(PointId id);
+  void clear() { tracks_.clear(); }
+  bool has(PointId id) const { return tracks_.count(id) > 0; }
+  size_t size() const { return tracks_.size(); }
+
+  /// Search windows of the tracked points among the predictions: the predicted undistorted
+  /// pixels mapped to raw pixels with the camera models, half-size track_window_sigmas times
+  /// the raw-pixel sigma (S mapped through the distortion's Jacobian), clamped to
+  /// [min_track_window, max_track_window]. Predictions of unknown ids are skipped.
+  std::vector<TrackWindow> windows(const std::vector<PredictedObservation>& predictions,
+                                   const CameraModel& left, const CameraModel& right) const;
+
+  /// Finds each window's point in both images: the keypoint in the window closest in
+  /// descriptor to the stored one (within max_track_descriptor_distance); a keypoint serves
+  /// one track at most (the better match wins). Found keypoints are flagged in *_used, and
+  /// the stored descriptors are refreshed. Points not found in both images are not returned.
+  std::vector<TrackMatch> track(const std::vector<TrackWindow>& windows, const FeatureSet& left,
+                                const FeatureSet& right, std::vector<char>* left_used,
+                                std::vector<char>* right_used);
+
+ private:
+  struct Track {
+    cv::Mat left_descriptor;
+    cv::Mat right_descriptor;
+  };
+  FrontEndConfig config_;
+  std::unordered_map<PointId, Track> tracks_;
+};
+
+}  // namespace osc

@@ -1,0 +1,84 @@
+/// @file stereo_front_end.h
+/// @brief The image front end of one stereo stream (seed Sec. II-A, II-C): per pair,
+/// predicted windows for the tracked points -> tracking -> detection and epipolar-guided
+/// matching of new points -> bucketing; then the estimator's report closes the frame.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include "online_stereo_calibration/core/config/filter_config.h"
+#include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
+#include "online_stereo_calibration/core/estimator/types.h"
+#include "online_stereo_calibration/core/frontend/epipolar_matcher.h"
+#include "online_stereo_calibration/core/frontend/feature_detection.h"
+#include "online_stereo_calibration/core/frontend/front_end_config.h"
+#include "online_stereo_calibration/core/frontend/point_tracker.h"
+#include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
+
+namespace osc {
+
+/// Front end of one stereo camera pair. Not thread-safe.
+class StereoFrontEnd {
+ public:
+  /// @throws std::invalid_argument listing FrontEndConfig::validate() problems.
+  StereoFrontEnd(const FrontEndConfig& config, const FilterConfig& filter_config,
+                 const CameraModel& left, const CameraModel& right);
+
+  /// First half of a frame: tracks the filter's points (windows from
+  /// filter.predictObservations(motion)), detects and matches new ones with the filter's
+  /// current x_camr and its covariance. Returns the observations for
+  /// StereoCalibrationEstimator::processFrame: the tracked points with their ids, then the
+  /// new candidates with fresh ids. Images: mono8 of the cameras' sizes.
+  std::vector<StereoObservation> observe(const cv::Mat& left_mono, const cv::Mat& right_mono,
+                                         const MotionIncrement& motion,
+                                         const CalibrationFilter& filter,
+                                         FrontEndStatistics* statistics);
+
+  /// Second half: forgets the dropped points, adopts the new candidates the filter took.
+  void commit(const FrameReport& report, const CalibrationFilter& filter);
+
+  /// Forgets every track.
+  void reset();
+
+  /// Tracked points found in the last pair (raw pixels, with ids).
+  const std::vector<StereoObservation>& lastTracked() const { return last_tracked_; }
+  /// New candidates offered in the last pair (raw pixels, with their fresh ids).
+  const std::vector<StereoObservation>& lastNewCandidates() const { return last_new_; }
+  /// All epipolar-guided matches of the last pair before the depth checks and bucketing
+  /// (raw pixels, id 0).
+  const std::vector<StereoObservation>& lastStereoMatches() const { return last_matches_; }
+  /// Search windows of the last pair.
+  const std::vector<TrackWindow>& lastWindows() const { return last_windows_; }
+  /// Points being tracked.
+  size_t trackCount() const { return tracker_.size(); }
+
+  /// The last pair side by side (BGR): tracks green, new candidates blue, other stereo
+  /// matches grey, search windows yellow (left) / cyan (right). Empty before the first pair.
+  cv::Mat debugImage() const;
+
+  const FrontEndConfig& config() const { return config_; }
+
+ private:
+  FrontEndConfig config_;
+  FilterConfig filter_config_;
+  CameraModel left_camera_, right_camera_;
+  FeatureDetector detector_;
+  EpipolarMatcher matcher_;
+  PointTracker tracker_;
+  PointId next_id_ = 1;
+
+  struct Pending {
+    PointId id;
+    cv::Mat left_descriptor, right_descriptor;
+  };
+  std::vector<Pending> pending_;
+  cv::Mat last_left_, last_right_;
+  std::vector<StereoObservation> last_tracked_, last_new_, last_matches_;
+  std::vector<TrackWindow> last_windows_;
+};
+
+}  // namespace osc
