@@ -33,10 +33,14 @@ TEST(PaperScenario, BeatsTableIAndIsNotOverconfident) {
   for (unsigned seed : {1u, 2u, 3u}) {
     MeasurementScenario scenario = paperOffroadScenario();
     scenario.seed = seed;
-    int recovered_at = -1;
+    int recovered_at = -1, jumps = 0;
     const auto results = runMeasurementScenario(scenario, FilterConfig());
     ASSERT_EQ(results.size(), 1500u);
     for (const ScenarioFrameResult& r : results) {
+      if (r.jump_detected) {
+        ++jumps;
+        EXPECT_EQ(r.frame, 774) << "seed " << seed << ": a jump where there was none";
+      }
       const Vector12d e = parameterError(r);
       if (r.frame > 774 && recovered_at < 0 && std::abs(e(5)) < 0.3 * kDeg) recovered_at = r.frame;
       if (r.frame < 1000 || r.frame > 1150) continue;
@@ -47,6 +51,7 @@ TEST(PaperScenario, BeatsTableIAndIsNotOverconfident) {
     // The step is detected and tracked back to 0.3 deg within 150 frames.
     EXPECT_GT(recovered_at, 774) << "seed " << seed;
     EXPECT_LT(recovered_at, 774 + 150) << "seed " << seed;
+    EXPECT_EQ(jumps, 1) << "seed " << seed;
   }
   for (int k = 0; k < 12; ++k) {
     const double rmse = std::sqrt(squared_error(k) / frames);

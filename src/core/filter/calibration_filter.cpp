@@ -286,12 +286,13 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
     }
   }
   const int tested = static_cast<int>(innovations.size());
+  // The left image does not see x_camr: if it fails too, x_caml moved (via eq. 8).
+  const JumpBlock suspect = 2 * left_failures >= static_cast<int>(report.outliers.size())
+                                ? JumpBlock::kVehicleToLeft
+                                : JumpBlock::kLeftToRight;
   if (detect_jump && tested >= config_.jump_min_points &&
-      report.outliers.size() >= config_.jump_rejected_fraction * tested) {
-    // The left image does not see x_camr: if it fails too, x_caml moved (via eq. 8).
-    report.jump = 2 * left_failures >= static_cast<int>(report.outliers.size())
-                      ? JumpBlock::kVehicleToLeft
-                      : JumpBlock::kLeftToRight;
+      report.outliers.size() >= config_.jump_rejected_fraction * tested && canReopen(suspect)) {
+    report.jump = suspect;
     if (shared) marginalizeMotionError(P);
     reopenBlock(report.jump);
     report.lost.reserve(points_.size());
@@ -448,6 +449,15 @@ void CalibrationFilter::marginalizeMotionError(const MatrixXd& P) {
     point.B = B_c;
   }
   covariance_ = P_cc;
+}
+
+bool CalibrationFilter::canReopen(JumpBlock block) const {
+  // While a block is still as uncertain as a re-opened one (start-up), many gated-out points
+  // are the ordinary transient, not a sudden change.
+  const int first = block == JumpBlock::kVehicleToLeft ? layout::kCaml : layout::kCamr;
+  const Vector6d variance = covariance_.diagonal().segment<6>(first);
+  return variance.segment<3>(layout::kRotation).maxCoeff() < std::pow(config_.jump_rotation_sigma, 2) &&
+         variance.segment<3>(layout::kTranslation).maxCoeff() < std::pow(config_.jump_translation_sigma, 2);
 }
 
 void CalibrationFilter::reopenBlock(JumpBlock block) {

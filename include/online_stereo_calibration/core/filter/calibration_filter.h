@@ -132,6 +132,7 @@ class CalibrationFilter {
   void predictPoints(const MotionIncrement& motion, const Eigen::MatrixXd& P_global,
                      std::vector<bool>* failed);
   void marginalizeMotionError(const Eigen::MatrixXd& P_global);
+  bool canReopen(JumpBlock block) const;
   void reopenBlock(JumpBlock block);
   void removeIndices(const std::vector<bool>& remove);
   bool repairCovariance();
