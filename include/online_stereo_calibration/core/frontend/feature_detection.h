@@ -24,8 +24,7 @@ namespace osc {
 /// intrinsics say, some contrast (not all black / saturated). Returns "" if usable, else a
 /// message starting with `which` (e.g. "left image") naming the problem.
 std::string toCheckedMono8(const cv::Mat& image, const CameraIntrinsics& intrinsics,
-                           const FrontEndConfig& config, const std::string& which,
-                           cv::Mat* mono);
+                           const FrontEndConfig& config, const std::string& which, cv::Mat* mono);
 
 /// Buckets of point indices on a regular grid, for window queries.
 class SpatialGrid {

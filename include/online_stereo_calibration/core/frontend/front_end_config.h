@@ -19,7 +19,7 @@ struct FrontEndConfig {
   /// FAST threshold (grey levels) of ORB / FAST_ORB, [1, 255].
   int fast_threshold = 12;
   /// Pyramid levels of ORB, [1, 16]; scale factor between them, (1, 2].
-  int orb_levels = 4;
+  int orb_levels = 1;
   double orb_scale_factor = 1.2;
   /// Keypoints are spread over a grid of this many cells per axis (the strongest per cell
   /// first), [1, 64]. 1 = no spreading.
@@ -40,7 +40,7 @@ struct FrontEndConfig {
   double pixel_sigma = 0.5;
   /// Largest normalised descriptor distance of a match: Hamming / bits for binary
   /// descriptors, L2 / sqrt(|a|^2 + |b|^2) for float ones. (0, 1].
-  double max_descriptor_distance = 0.25;
+  double max_descriptor_distance = 0.2;
   /// Lowe's ratio: best distance < ratio * second best among the candidates, (0, 1].
   double ratio = 0.8;
 
@@ -63,7 +63,7 @@ struct FrontEndConfig {
   double min_track_window = 3.0;   ///< [0.5, 100]
   double max_track_window = 40.0;  ///< [min_track_window, 500]
   /// Largest normalised descriptor distance of a track to its stored descriptor, (0, 1].
-  double max_track_descriptor_distance = 0.3;
+  double max_track_descriptor_distance = 0.2;
 
   // --- input checks ---
   /// Least image size (px, each axis) accepted, [8, 10000].

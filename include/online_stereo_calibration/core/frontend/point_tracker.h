@@ -4,6 +4,7 @@
 /// covariance S, and matched against its stored descriptors.
 #pragma once
 
+#include <functional>
 #include <unordered_map>
 #include <vector>
 
@@ -57,9 +58,12 @@ class PointTracker {
   /// descriptor to the stored one (within max_track_descriptor_distance); a keypoint serves
   /// one track at most (the better match wins). Found keypoints are flagged in *_used, and
   /// the stored descriptors are refreshed. Points not found in both images are not returned.
+  /// If given, `consistent(left_index, right_index)` must accept the right keypoint for the
+  /// chosen left one (e.g. the epipolar band of eq. 5-6).
   std::vector<TrackMatch> track(const std::vector<TrackWindow>& windows, const FeatureSet& left,
                                 const FeatureSet& right, std::vector<char>* left_used,
-                                std::vector<char>* right_used);
+                                std::vector<char>* right_used,
+                                const std::function<bool(int, int)>& consistent = {});
 
  private:
   struct Track {

@@ -40,9 +40,14 @@ struct ImageFrameResult {
   int matches_correct = 0;  ///< ... of which within tolerance of the truth
   int new_checked = 0;      ///< new candidates offered
   int new_correct = 0;
-  int tracks_checked = 0;  ///< tracked points reported (whose birth point is known)
-  int tracks_correct = 0;  ///< ... within tolerance of the true projections of the point
-                           ///< seen at their birth, in both images
+  int tracks_reported = 0;  ///< tracked points reported to the estimator
+  /// ... whose stereo pair is correct in this frame (as for matches: the surface point at the
+  /// left pixel projects within tolerance of the right pixel)
+  int tracks_stereo_correct = 0;
+  int tracks_checked = 0;  ///< tracked points reported whose birth point is known
+  /// ... still on the point seen at their birth: within tolerance of its true projections in
+  /// both images (stricter: includes drift along the track)
+  int tracks_correct = 0;
   double render_ms = 0.0;  ///< time spent rendering this pair
 };
 
@@ -62,7 +67,6 @@ bool isCorrectStereoMatch(const StereoSceneRenderer& renderer, const CameraModel
 std::vector<ImageFrameResult> runImageScenario(
     const MeasurementScenario& scenario, const FilterConfig& filter_config,
     const FrontEndConfig& front_end_config, const ImageScenarioOptions& options = {},
-    const std::function<void(const ImageFrameResult&, const CalibrationPipeline&)>& on_frame =
-        {});
+    const std::function<void(const ImageFrameResult&, const CalibrationPipeline&)>& on_frame = {});
 
 }  // namespace osc

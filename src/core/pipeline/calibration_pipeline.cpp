@@ -1,0 +1,102 @@
+#include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
+
+#include <chrono>
+
+#include "online_stereo_calibration/core/frontend/feature_detection.h"
+#include "online_stereo_calibration/core/frontend/stereo_front_end.h"
+
+namespace osc {
+
+CalibrationPipeline::CalibrationPipeline(const FilterConfig& filter_config,
+                                         const FrontEndConfig& front_end_config,
+                                         const CameraIntrinsics& left,
+                                         const CameraIntrinsics& right,
+                                         const StereoExtrinsics& initial_guess)
+    : estimator_(
+          std::make_unique<StereoCalibrationEstimator>(filter_config, left, right, initial_guess)),
+      front_end_(std::make_unique<StereoFrontEnd>(
+          front_end_config, filter_config, estimator_->leftCamera(), estimator_->rightCamera())) {}
+
+CalibrationPipeline::~CalibrationPipeline() = default;
+
+PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& right,
+                                            const MotionIncrement& motion_since_previous) {
+  const auto start = std::chrono::steady_clock::now();
+  PipelineResult result;
+  // A skipped pair's motion is kept and composed with the next one, so that the motion
+  // handed to the estimator always spans the time since the last processed pair.
+  MotionIncrement motion = motion_since_previous;
+  if (has_pending_motion_) {
+    motion.T_prev_curr = pending_motion_.T_prev_curr * motion_since_previous.T_prev_curr;
+    motion.dt = pending_motion_.dt + motion_since_previous.dt;
+  }
+  const FrontEndConfig& config = front_end_->config();
+  cv::Mat left_mono, right_mono;
+  std::string problem =
+      toCheckedMono8(left, estimator_->leftCamera().intrinsics(), config, "left image", &left_mono);
+  if (problem.empty()) {
+    problem = toCheckedMono8(right, estimator_->rightCamera().intrinsics(), config, "right image",
+                             &right_mono);
+  }
+  if (problem.empty() && left.size() != right.size()) {
+    problem = "left and right images differ in size";
+  }
+  if (!problem.empty()) {
+    result.processed = false;
+    result.status = problem;
+    if (processed_any_) {
+      pending_motion_ = motion;
+      has_pending_motion_ = true;
+    }
+    result.estimate = estimator_->estimate();
+    result.processing_time =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  }
+  const std::vector<StereoObservation> observations =
+      front_end_->observe(left_mono, right_mono, motion, estimator_->filter(), &result.front_end);
+  result.estimator = estimator_->processFrame(motion, observations);
+  front_end_->commit(result.estimator, estimator_->filter());
+  has_pending_motion_ = false;
+  processed_any_ = true;
+  result.processed = true;
+  result.status =
+      result.estimator.motion_rejected ? "processed (motion rejected, tracks reset)" : "ok";
+  result.estimate = estimator_->estimate();
+  result.processing_time =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+void CalibrationPipeline::resetTracking() {
+  estimator_->resetTracking();
+  front_end_->reset();
+  has_pending_motion_ = false;
+}
+
+void CalibrationPipeline::reset(const StereoExtrinsics& guess) {
+  estimator_->reset(guess);
+  front_end_->reset();
+  has_pending_motion_ = false;
+}
+
+void CalibrationPipeline::reset(const StereoExtrinsics& guess,
+                                const Matrix12d& tangent_covariance) {
+  estimator_->reset(guess, tangent_covariance);
+  front_end_->reset();
+  has_pending_motion_ = false;
+}
+
+CalibrationEstimate CalibrationPipeline::estimate() const { return estimator_->estimate(); }
+
+std::vector<PointEstimate> CalibrationPipeline::points() const {
+  return estimator_->filter().points();
+}
+
+cv::Mat CalibrationPipeline::debugImage() const { return front_end_->debugImage(); }
+
+const StereoCalibrationEstimator& CalibrationPipeline::estimator() const { return *estimator_; }
+
+const StereoFrontEnd& CalibrationPipeline::frontEnd() const { return *front_end_; }
+
+}  // namespace osc
