@@ -1,0 +1,116 @@
+/// @file drive_simulation.cpp
+/// @brief The image-level simulated drive (see drive_simulation.h).
+#include "online_stereo_calibration/tools/drive_simulation.h"
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace osc {
+namespace {
+
+/// The scenario's motion noise sigmas refer to steps of this length (s).
+constexpr double kNoiseReferenceStep = 0.1;
+/// Spacing of the ground-track polyline handed to the scene (m).
+constexpr double kPathSpacing = 1.0;
+
+}  // namespace
+
+DriveSimulator::DriveSimulator(const SimulationScenario& scenario, int frames)
+    : scenario_(scenario),
+      frames_(frames > 0 ? frames : scenario.measurement.frames),
+      left_(scenario.measurement.left),
+      right_(scenario.measurement.right) {
+  scenario_.measurement.frames = frames_;
+  const double duration =
+      (frames_ - 1) / scenario_.measurement.rate_hz + 2.0 / scenario_.rendering.odom_rate_hz;
+  if (scenario_.trajectory) {
+    recorded_ = readTumTrajectory(scenario_.trajectory->file);
+    recorded_start_ = recorded_.firstStamp() + scenario_.trajectory->start_offset;
+    if (recorded_start_ + duration > recorded_.lastStamp()) {
+      throw std::invalid_argument(
+          "frames: " + std::to_string(frames_) + " frames at " +
+          std::to_string(scenario_.measurement.rate_hz) + " Hz need " + std::to_string(duration) +
+          " s but trajectory.tum_file covers only " +
+          std::to_string(recorded_.lastStamp() - recorded_start_) + " s after start_offset");
+    }
+  } else {
+    analytic_ = std::make_unique<VehicleTrajectory>(scenario_.measurement.motion);
+  }
+  SceneConfig scene;
+  scene.seed = scenario_.rendering.scene_seed;
+  scene.ground_undulation = scenario_.rendering.ground_undulation;
+  scene.structure_density = scenario_.rendering.structure_density;
+  Eigen::Vector2d last = truePose(0.0).translation().head<2>();
+  scene.path.push_back(last);
+  for (double t = 0.0; t <= duration; t += 0.05) {
+    const Eigen::Vector2d p = truePose(t).translation().head<2>();
+    if ((p - last).norm() >= kPathSpacing) {
+      scene.path.push_back(p);
+      last = p;
+    }
+  }
+  renderer_ = std::make_unique<StereoSceneRenderer>(scene);
+}
+
+DriveSimulator::~DriveSimulator() = default;
+
+double DriveSimulator::frameStamp(int frame) const {
+  return scenario_.rendering.start_stamp + frame / scenario_.measurement.rate_hz;
+}
+
+Eigen::Isometry3d DriveSimulator::truePose(double t) const {
+  if (analytic_) return analytic_->pose(t);
+  const auto pose = recorded_.at(recorded_start_ + t, 1e-9);
+  if (!pose) throw std::out_of_range("DriveSimulator: time outside the recorded trajectory");
+  return *pose;
+}
+
+SimulatedImagePair DriveSimulator::renderFrame(int frame) const {
+  SimulatedImagePair out;
+  out.frame = frame;
+  out.stamp = frameStamp(frame);
+  out.truth = truthAt(frame);
+  out.T_world_veh = truePose(frame / scenario_.measurement.rate_hz);
+  const StereoExtrinsics truth = StereoExtrinsics::fromParameters(out.truth);
+  const Eigen::Isometry3d T_world_lopt = out.T_world_veh * truth.vehicleToLeftOptical();
+  const Eigen::Isometry3d T_world_ropt = T_world_lopt * truth.leftToRightOptical();
+  RenderOptions options;
+  options.noise_sigma = scenario_.rendering.image_noise;
+  options.blur_sigma = scenario_.rendering.blur_sigma;
+  options.supersampling = scenario_.rendering.supersampling;
+  options.noise_seed = 2u * static_cast<unsigned>(frame) + 1u;
+  out.left = renderer_->render(left_, T_world_lopt, options);
+  options.noise_seed += 1u;
+  out.right = renderer_->render(right_, T_world_ropt, options);
+  return out;
+}
+
+std::vector<StampedPose> DriveSimulator::odometry() const {
+  const double period = 1.0 / scenario_.rendering.odom_rate_hz;
+  const double end = (frames_ - 1) / scenario_.measurement.rate_hz + period;
+  const int samples = static_cast<int>(std::ceil(end / period - 1e-9)) + 1;
+  const double scale = std::sqrt(period / kNoiseReferenceStep);
+  std::mt19937_64 engine(0x5eedULL * (scenario_.measurement.seed + 1ULL) + 17ULL);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::Isometry3d error = Eigen::Isometry3d::Identity();
+  std::vector<StampedPose> out;
+  out.reserve(samples);
+  for (int k = 0; k < samples; ++k) {
+    const double t = k * period;
+    if (k > 0) {
+      Vector6d delta;
+      for (int i = 0; i < 3; ++i) {
+        delta(i) = scale * scenario_.measurement.motion_translation_noise * normal(engine);
+      }
+      for (int i = 3; i < 6; ++i) {
+        delta(i) = scale * scenario_.measurement.motion_rotation_noise * normal(engine);
+      }
+      error = boxPlus(error, delta);
+    }
+    out.push_back({scenario_.rendering.start_stamp + t, truePose(t) * error});
+  }
+  return out;
+}
+
+}  // namespace osc

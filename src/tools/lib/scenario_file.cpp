@@ -1,0 +1,416 @@
+/// @file scenario_file.cpp
+/// @brief Parser of the simulator's scenario files (see scenario_file.h).
+#include "online_stereo_calibration/tools/scenario_file.h"
+
+#include <sys/stat.h>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+namespace osc {
+namespace {
+
+/// Version of the simulator's output; part of the cache fingerprint.
+constexpr const char* kSimulatorVersion = "simulate-1";
+
+/// Collects problems instead of stopping at the first.
+struct Problems {
+  std::vector<std::string> list;
+  void add(const std::string& key, const std::string& what) { list.push_back(key + ": " + what); }
+};
+
+bool fileExists(const std::string& path) {
+  struct stat st;
+  return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+std::string resolvePath(const std::string& path, const std::string& base_directory) {
+  if (path.empty() || path[0] == '/') return path;
+  const std::string relative = base_directory.empty() ? path : base_directory + "/" + path;
+  if (fileExists(relative)) return relative;
+  if (fileExists(path)) return path;
+  return relative;
+}
+
+void checkKeys(const YAML::Node& node, const std::string& prefix,
+               const std::set<std::string>& allowed, Problems* problems) {
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    if (!allowed.count(key)) problems->add(prefix + key, "unknown key");
+  }
+}
+
+bool readDouble(const YAML::Node& node, const std::string& key, double* out, Problems* p) {
+  try {
+    const double v = node.as<double>();
+    if (!std::isfinite(v)) {
+      p->add(key, "not finite");
+      return false;
+    }
+    *out = v;
+    return true;
+  } catch (const YAML::Exception&) {
+    p->add(key, "not a number");
+    return false;
+  }
+}
+
+template <typename Int>
+void readInt(const YAML::Node& node, const std::string& key, Int* out, Problems* p) {
+  try {
+    *out = node.as<Int>();
+  } catch (const YAML::Exception&) {
+    p->add(key, "not an integer");
+  }
+}
+
+void readVector(const YAML::Node& node, const std::string& key, int size, double* out,
+                Problems* p) {
+  if (!node.IsSequence() || static_cast<int>(node.size()) != size) {
+    p->add(key, "must be a list of " + std::to_string(size) + " numbers");
+    return;
+  }
+  for (int i = 0; i < size; ++i) readDouble(node[i], key, &out[i], p);
+}
+
+/// {vehicle_to_left: [6], left_to_right: [6]} into a 12-vector (keys left out keep values).
+void readParameters(const YAML::Node& node, const std::string& key, Vector12d* out, Problems* p) {
+  if (!node.IsMap()) {
+    p->add(key, "must be a map with vehicle_to_left and/or left_to_right");
+    return;
+  }
+  checkKeys(node, key + ".", {"vehicle_to_left", "left_to_right"}, p);
+  if (node["vehicle_to_left"]) {
+    readVector(node["vehicle_to_left"], key + ".vehicle_to_left", 6, out->data(), p);
+  }
+  if (node["left_to_right"]) {
+    readVector(node["left_to_right"], key + ".left_to_right", 6, out->data() + 6, p);
+  }
+}
+
+void readCamera(const YAML::Node& node, const std::string& key, const std::string& base,
+                CameraIntrinsics* camera, Problems* p) {
+  if (!node.IsMap()) {
+    p->add(key, "must be a map");
+    return;
+  }
+  checkKeys(node, key + ".",
+            {"width", "height", "fx", "fy", "cx", "cy", "distortion_model", "distortion",
+             "euroc_sensor_yaml"},
+            p);
+  if (node["euroc_sensor_yaml"]) {
+    try {
+      *camera = readEurocIntrinsics(resolvePath(node["euroc_sensor_yaml"].as<std::string>(), base));
+    } catch (const std::exception& e) {
+      p->add(key + ".euroc_sensor_yaml", e.what());
+    }
+  }
+  if (node["width"]) readInt(node["width"], key + ".width", &camera->width, p);
+  if (node["height"]) readInt(node["height"], key + ".height", &camera->height, p);
+  if (node["fx"]) readDouble(node["fx"], key + ".fx", &camera->fx, p);
+  if (node["fy"]) readDouble(node["fy"], key + ".fy", &camera->fy, p);
+  if (node["cx"]) readDouble(node["cx"], key + ".cx", &camera->cx, p);
+  if (node["cy"]) readDouble(node["cy"], key + ".cy", &camera->cy, p);
+  if (node["distortion_model"]) {
+    try {
+      camera->model = distortionModelFromName(node["distortion_model"].as<std::string>());
+    } catch (const std::exception& e) {
+      p->add(key + ".distortion_model", e.what());
+    }
+  }
+  if (node["distortion"]) {
+    if (!node["distortion"].IsSequence()) {
+      p->add(key + ".distortion", "must be a list of numbers");
+    } else {
+      camera->distortion.assign(node["distortion"].size(), 0.0);
+      for (std::size_t i = 0; i < camera->distortion.size(); ++i) {
+        readDouble(node["distortion"][i], key + ".distortion", &camera->distortion[i], p);
+      }
+    }
+  }
+  try {
+    CameraModel check(*camera);
+  } catch (const std::exception& e) {
+    p->add(key, e.what());
+  }
+}
+
+/// Loads a YAML file that may start with OpenCV's "%YAML:1.0" line (EuRoC files do).
+YAML::Node loadOpenCvYaml(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot open '" + path + "'");
+  std::ostringstream text;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("%YAML", 0) == 0) continue;
+    text << line << "\n";
+  }
+  return YAML::Load(text.str());
+}
+
+/// T_BS of an EuRoC sensor.yaml: the sensor (optical) frame in the body (IMU) frame.
+Eigen::Isometry3d readEurocTBS(const std::string& path) {
+  const YAML::Node root = loadOpenCvYaml(path);
+  const YAML::Node data = root["T_BS"]["data"];
+  if (!data || !data.IsSequence() || data.size() != 16) {
+    throw std::runtime_error(path + ": T_BS.data must hold 16 numbers");
+  }
+  Eigen::Matrix4d m;
+  for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = data[i].as<double>();
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  // Orthonormalise the rotation (the file has ~1e-9 rounding).
+  const Eigen::Quaterniond q(Eigen::Matrix3d(m.block<3, 3>(0, 0)));
+  T.linear() = q.normalized().toRotationMatrix();
+  T.translation() = m.block<3, 1>(0, 3);
+  return T;
+}
+
+void readTruth(const YAML::Node& node, const std::string& base, Vector12d* truth, Problems* p) {
+  if (node.IsMap() && (node["euroc_left"] || node["euroc_right"] || node["R_body_vehicle"])) {
+    checkKeys(node, "truth.", {"euroc_left", "euroc_right", "R_body_vehicle"}, p);
+    if (!node["euroc_left"] || !node["euroc_right"] || !node["R_body_vehicle"]) {
+      p->add("truth", "euroc_left, euroc_right and R_body_vehicle go together");
+      return;
+    }
+    double r[9];
+    const std::size_t before = p->list.size();
+    readVector(node["R_body_vehicle"], "truth.R_body_vehicle", 9, r, p);
+    if (p->list.size() != before) return;
+    Eigen::Matrix3d R_body_vehicle;
+    for (int i = 0; i < 9; ++i) R_body_vehicle(i / 3, i % 3) = r[i];
+    if (!(R_body_vehicle.transpose() * R_body_vehicle).isIdentity(1e-6)) {
+      p->add("truth.R_body_vehicle", "not a rotation matrix");
+      return;
+    }
+    try {
+      Eigen::Isometry3d T_vehicle_body = Eigen::Isometry3d::Identity();
+      T_vehicle_body.linear() = R_body_vehicle.transpose();
+      const Eigen::Isometry3d T_body_optical_inv = bodyFromOptical().inverse();
+      const Eigen::Isometry3d left =
+          T_vehicle_body * readEurocTBS(resolvePath(node["euroc_left"].as<std::string>(), base)) *
+          T_body_optical_inv;
+      const Eigen::Isometry3d right =
+          T_vehicle_body * readEurocTBS(resolvePath(node["euroc_right"].as<std::string>(), base)) *
+          T_body_optical_inv;
+      StereoExtrinsics extrinsics;
+      extrinsics.T_veh_caml = left;
+      extrinsics.T_caml_camr = left.inverse() * right;
+      *truth = extrinsics.toParameters();
+    } catch (const std::exception& e) {
+      p->add("truth", e.what());
+    }
+    return;
+  }
+  readParameters(node, "truth", truth, p);
+}
+
+void readMotion(const YAML::Node& node, VehicleMotionProfile* m, Problems* p) {
+  if (!node.IsMap()) {
+    p->add("motion", "must be a map");
+    return;
+  }
+  checkKeys(node, "motion.",
+            {"speed", "roll_amplitude", "pitch_amplitude", "roll_period", "pitch_period",
+             "yaw_rate_amplitude", "yaw_period", "heave_amplitude", "heave_period", "planar"},
+            p);
+  const std::pair<const char*, double*> fields[] = {{"speed", &m->speed},
+                                                    {"roll_amplitude", &m->roll_amplitude},
+                                                    {"pitch_amplitude", &m->pitch_amplitude},
+                                                    {"roll_period", &m->roll_period},
+                                                    {"pitch_period", &m->pitch_period},
+                                                    {"yaw_rate_amplitude", &m->yaw_rate_amplitude},
+                                                    {"yaw_period", &m->yaw_period},
+                                                    {"heave_amplitude", &m->heave_amplitude},
+                                                    {"heave_period", &m->heave_period}};
+  for (const auto& f : fields) {
+    if (node[f.first]) readDouble(node[f.first], std::string("motion.") + f.first, f.second, p);
+  }
+  if (node["planar"]) {
+    try {
+      m->planar = node["planar"].as<bool>();
+    } catch (const YAML::Exception&) {
+      p->add("motion.planar", "not a boolean");
+    }
+  }
+}
+
+void readRendering(const YAML::Node& node, SceneRenderingOptions* r, Problems* p) {
+  if (!node.IsMap()) {
+    p->add("rendering", "must be a map");
+    return;
+  }
+  checkKeys(node, "rendering.",
+            {"scene_seed", "ground_undulation", "structure_density", "image_noise", "blur_sigma",
+             "supersampling", "odom_rate_hz", "start_stamp"},
+            p);
+  if (node["scene_seed"]) readInt(node["scene_seed"], "rendering.scene_seed", &r->scene_seed, p);
+  if (node["supersampling"]) {
+    readInt(node["supersampling"], "rendering.supersampling", &r->supersampling, p);
+  }
+  const std::pair<const char*, double*> fields[] = {{"ground_undulation", &r->ground_undulation},
+                                                    {"structure_density", &r->structure_density},
+                                                    {"image_noise", &r->image_noise},
+                                                    {"blur_sigma", &r->blur_sigma},
+                                                    {"odom_rate_hz", &r->odom_rate_hz},
+                                                    {"start_stamp", &r->start_stamp}};
+  for (const auto& f : fields) {
+    if (node[f.first]) readDouble(node[f.first], std::string("rendering.") + f.first, f.second, p);
+  }
+  if (r->ground_undulation < 0) p->add("rendering.ground_undulation", "must be >= 0");
+  if (r->structure_density < 0) p->add("rendering.structure_density", "must be >= 0");
+  if (r->image_noise < 0) p->add("rendering.image_noise", "must be >= 0");
+  if (r->blur_sigma < 0) p->add("rendering.blur_sigma", "must be >= 0");
+  if (r->supersampling < 1 || r->supersampling > 4)
+    p->add("rendering.supersampling", "must be 1-4");
+  if (!(r->odom_rate_hz > 0)) p->add("rendering.odom_rate_hz", "must be > 0");
+  if (!(r->start_stamp >= 1)) p->add("rendering.start_stamp", "must be >= 1 s");
+}
+
+void readTrajectory(const YAML::Node& node, const std::string& base,
+                    std::optional<TumTrajectoryOption>* out, Problems* p) {
+  if (!node.IsMap()) {
+    p->add("trajectory", "must be a map");
+    return;
+  }
+  checkKeys(node, "trajectory.", {"tum_file", "start_offset"}, p);
+  if (!node["tum_file"]) {
+    p->add("trajectory.tum_file", "missing");
+    return;
+  }
+  TumTrajectoryOption option;
+  option.file = resolvePath(node["tum_file"].as<std::string>(), base);
+  if (!fileExists(option.file)) p->add("trajectory.tum_file", "no such file '" + option.file + "'");
+  if (node["start_offset"]) {
+    readDouble(node["start_offset"], "trajectory.start_offset", &option.start_offset, p);
+    if (option.start_offset < 0) p->add("trajectory.start_offset", "must be >= 0");
+  }
+  *out = option;
+}
+
+MeasurementScenario presetByName(const std::string& name, Problems* p) {
+  if (name == "paper_offroad") return paperOffroadScenario();
+  if (name == "urban_planar") return urbanPlanarScenario();
+  if (name == "drift") return driftScenario();
+  p->add("base", "unknown preset '" + name + "' (paper_offroad, urban_planar, drift)");
+  return paperOffroadScenario();
+}
+
+}  // namespace
+
+CameraIntrinsics readEurocIntrinsics(const std::string& path) {
+  const YAML::Node root = loadOpenCvYaml(path);
+  const YAML::Node resolution = root["resolution"];
+  const YAML::Node intrinsics = root["intrinsics"];
+  const YAML::Node distortion = root["distortion_coefficients"];
+  if (!resolution || resolution.size() != 2 || !intrinsics || intrinsics.size() != 4 ||
+      !distortion) {
+    throw std::runtime_error(path +
+                             ": needs resolution [2], intrinsics [4] and "
+                             "distortion_coefficients");
+  }
+  const std::string model =
+      root["distortion_model"] ? root["distortion_model"].as<std::string>() : "radial-tangential";
+  if (model != "radial-tangential") {
+    throw std::runtime_error(path + ": distortion_model '" + model + "' not supported");
+  }
+  CameraIntrinsics c;
+  c.width = resolution[0].as<int>();
+  c.height = resolution[1].as<int>();
+  c.fx = intrinsics[0].as<double>();
+  c.fy = intrinsics[1].as<double>();
+  c.cx = intrinsics[2].as<double>();
+  c.cy = intrinsics[3].as<double>();
+  c.model = DistortionModel::kPlumbBob;
+  for (const auto& d : distortion) c.distortion.push_back(d.as<double>());
+  return c;
+}
+
+SimulationScenario parseScenarioYaml(const std::string& text, const std::string& source_name,
+                                     const std::string& base_directory) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(source_name + ": not valid YAML: " + e.what());
+  }
+  if (!root.IsMap()) throw std::runtime_error(source_name + ": must be a YAML map");
+  Problems p;
+  checkKeys(root, "",
+            {"base", "name", "frames", "rate_hz", "seed", "left_camera", "right_camera", "truth",
+             "initial_error", "step_frame", "step", "drift_per_second", "motion",
+             "motion_rotation_noise", "motion_translation_noise", "trajectory", "rendering"},
+            &p);
+  SimulationScenario s;
+  s.source_text = text;
+  std::string base = "paper_offroad";
+  if (root["base"]) base = root["base"].as<std::string>();
+  s.measurement = presetByName(base, &p);
+  MeasurementScenario& m = s.measurement;
+  if (root["name"]) m.name = root["name"].as<std::string>();
+  if (root["frames"]) readInt(root["frames"], "frames", &m.frames, &p);
+  if (root["rate_hz"]) readDouble(root["rate_hz"], "rate_hz", &m.rate_hz, &p);
+  if (root["seed"]) readInt(root["seed"], "seed", &m.seed, &p);
+  if (root["left_camera"])
+    readCamera(root["left_camera"], "left_camera", base_directory, &m.left, &p);
+  if (root["right_camera"]) {
+    readCamera(root["right_camera"], "right_camera", base_directory, &m.right, &p);
+  }
+  if (root["truth"]) readTruth(root["truth"], base_directory, &m.truth, &p);
+  if (root["initial_error"])
+    readParameters(root["initial_error"], "initial_error", &m.initial_error, &p);
+  if (root["step_frame"]) readInt(root["step_frame"], "step_frame", &m.step_frame, &p);
+  if (root["step"]) readParameters(root["step"], "step", &m.step, &p);
+  if (root["drift_per_second"]) {
+    readParameters(root["drift_per_second"], "drift_per_second", &m.drift_per_second, &p);
+  }
+  if (root["motion"]) readMotion(root["motion"], &m.motion, &p);
+  if (root["motion_rotation_noise"]) {
+    readDouble(root["motion_rotation_noise"], "motion_rotation_noise", &m.motion_rotation_noise,
+               &p);
+  }
+  if (root["motion_translation_noise"]) {
+    readDouble(root["motion_translation_noise"], "motion_translation_noise",
+               &m.motion_translation_noise, &p);
+  }
+  if (root["trajectory"]) readTrajectory(root["trajectory"], base_directory, &s.trajectory, &p);
+  if (root["rendering"]) readRendering(root["rendering"], &s.rendering, &p);
+  if (p.list.empty()) {
+    for (const std::string& problem : m.validate()) p.list.push_back(problem);
+  }
+  if (!p.list.empty()) {
+    std::string message = source_name + ":";
+    for (const std::string& problem : p.list) message += "\n  " + problem;
+    throw std::runtime_error(message);
+  }
+  return s;
+}
+
+SimulationScenario readScenarioFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot open scenario file '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  const auto slash = path.find_last_of('/');
+  const std::string directory = slash == std::string::npos ? "." : path.substr(0, slash);
+  return parseScenarioYaml(text.str(), path, directory);
+}
+
+std::string scenarioFingerprint(const SimulationScenario& scenario, int frames) {
+  const std::string text = std::string(kSimulatorVersion) + "\nframes=" + std::to_string(frames) +
+                           "\n" + scenario.source_text;
+  std::uint64_t hash = 1469598103934665603ULL;
+  for (unsigned char c : text) {
+    hash ^= c;
+    hash *= 1099511628211ULL;
+  }
+  char buffer[17];
+  std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(hash));
+  return buffer;
+}
+
+}  // namespace osc

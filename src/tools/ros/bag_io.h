@@ -1,0 +1,186 @@
+/// @file bag_io.h
+/// @brief ROS message conversions and bag reading shared by `simulate`, `evaluate` and their
+/// tests (header-only: the bag tools have no library of their own). No ROS master needed.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <geometry_msgs/Transform.h>
+#include <nav_msgs/Odometry.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <std_msgs/String.h>
+#include <Eigen/Geometry>
+
+#include "online_stereo_calibration/StereoCalibration.h"
+#include "online_stereo_calibration/core/geometry/camera_model.h"
+#include "online_stereo_calibration/core/geometry/pose.h"
+#include "online_stereo_calibration/tools/pose_interpolation.h"
+
+namespace osc::bag {
+
+/// Topic and frame names of a simulated drive (what `evaluate` reads by default).
+struct DriveTopics {
+  std::string left_image = "/stereo/left/image_raw";
+  std::string right_image = "/stereo/right/image_raw";
+  std::string left_info = "/stereo/left/camera_info";
+  std::string right_info = "/stereo/right/camera_info";
+  std::string odom = "/odom";
+  std::string truth = "/ground_truth/calibration";
+  /// std_msgs/String: "fingerprint: <hex>" then the scenario file (the cache key).
+  std::string scenario = "/simulation/scenario";
+  std::string odom_frame = "odom";
+  std::string vehicle_frame = "base_link";
+  std::string left_frame = "left_camera_optical";
+  std::string right_frame = "right_camera_optical";
+};
+
+inline geometry_msgs::Transform toTransform(const Eigen::Isometry3d& T) {
+  geometry_msgs::Transform out;
+  out.translation.x = T.translation().x();
+  out.translation.y = T.translation().y();
+  out.translation.z = T.translation().z();
+  const Eigen::Quaterniond q(T.rotation());
+  out.rotation.x = q.x();
+  out.rotation.y = q.y();
+  out.rotation.z = q.z();
+  out.rotation.w = q.w();
+  return out;
+}
+
+inline Eigen::Isometry3d fromPose(const geometry_msgs::Pose& pose) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(pose.orientation.w, pose.orientation.x, pose.orientation.y,
+                                  pose.orientation.z)
+                   .normalized()
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
+  return T;
+}
+
+/// sensor_msgs/CameraInfo of unrectified intrinsics: K, D, distortion_model, R = I,
+/// P = [K | 0] (the left camera's convention for a raw stream).
+inline sensor_msgs::CameraInfo toCameraInfo(const CameraIntrinsics& c, const ros::Time& stamp,
+                                            const std::string& frame_id) {
+  sensor_msgs::CameraInfo info;
+  info.header.stamp = stamp;
+  info.header.frame_id = frame_id;
+  info.width = c.width;
+  info.height = c.height;
+  info.distortion_model =
+      c.model == DistortionModel::kNone ? "plumb_bob" : distortionModelName(c.model);
+  info.D = c.distortion;
+  if (c.model == DistortionModel::kNone) info.D.assign(5, 0.0);
+  info.K = {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1};
+  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  info.P = {c.fx, 0, c.cx, 0, 0, c.fy, c.cy, 0, 0, 0, 1, 0};
+  return info;
+}
+
+/// The intrinsics in a CameraInfo (K, D, distortion_model, size). All-zero D means none.
+inline CameraIntrinsics fromCameraInfo(const sensor_msgs::CameraInfo& info) {
+  CameraIntrinsics c;
+  c.width = static_cast<int>(info.width);
+  c.height = static_cast<int>(info.height);
+  c.fx = info.K[0];
+  c.fy = info.K[4];
+  c.cx = info.K[2];
+  c.cy = info.K[5];
+  bool all_zero = true;
+  for (double d : info.D) all_zero = all_zero && d == 0.0;
+  if (info.D.empty() || all_zero) {
+    c.model = DistortionModel::kNone;
+  } else {
+    c.model = distortionModelFromName(info.distortion_model);
+    c.distortion = info.D;
+  }
+  return c;
+}
+
+/// A StereoCalibration message of known parameters (covariance and sigma zero): the truth.
+inline online_stereo_calibration::StereoCalibration toCalibrationMessage(
+    const Vector12d& parameters, const ros::Time& stamp, const DriveTopics& names) {
+  online_stereo_calibration::StereoCalibration msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = names.vehicle_frame;
+  msg.left_frame_id = names.left_frame;
+  msg.right_frame_id = names.right_frame;
+  const StereoExtrinsics e = StereoExtrinsics::fromParameters(parameters);
+  msg.vehicle_to_left = toTransform(e.vehicleToLeftOptical());
+  msg.left_to_right = toTransform(e.leftToRightOptical());
+  for (int i = 0; i < 12; ++i) msg.parameters[i] = parameters(i);
+  msg.state = online_stereo_calibration::StereoCalibration::STATE_CONVERGED;
+  return msg;
+}
+
+/// nav_msgs/Odometry of a pose (twist left zero: `evaluate` uses poses only).
+inline nav_msgs::Odometry toOdometry(const StampedPose& pose, const DriveTopics& names) {
+  nav_msgs::Odometry msg;
+  msg.header.stamp.fromSec(pose.stamp);
+  msg.header.frame_id = names.odom_frame;
+  msg.child_frame_id = names.vehicle_frame;
+  const geometry_msgs::Transform t = toTransform(pose.pose);
+  msg.pose.pose.position.x = t.translation.x;
+  msg.pose.pose.position.y = t.translation.y;
+  msg.pose.pose.position.z = t.translation.z;
+  msg.pose.pose.orientation = t.rotation;
+  return msg;
+}
+
+/// Every pose of an odometry topic, in stamp order (out-of-order messages are sorted).
+inline PoseTrajectory readOdometry(const rosbag::Bag& bag, const std::string& topic) {
+  std::vector<StampedPose> poses;
+  rosbag::View view(bag, rosbag::TopicQuery(topic));
+  for (const rosbag::MessageInstance& m : view) {
+    const auto odom = m.instantiate<nav_msgs::Odometry>();
+    if (odom) poses.push_back({odom->header.stamp.toSec(), fromPose(odom->pose.pose)});
+  }
+  std::stable_sort(poses.begin(), poses.end(),
+                   [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
+  PoseTrajectory trajectory;
+  for (const StampedPose& p : poses) trajectory.append(p.stamp, p.pose);
+  return trajectory;
+}
+
+/// The parameters of every StereoCalibration message on a topic: (header stamp in ns,
+/// parameters), in bag order.
+inline std::vector<std::pair<std::int64_t, Vector12d>> readCalibrationTopic(
+    const rosbag::Bag& bag, const std::string& topic) {
+  std::vector<std::pair<std::int64_t, Vector12d>> out;
+  rosbag::View view(bag, rosbag::TopicQuery(topic));
+  for (const rosbag::MessageInstance& m : view) {
+    const auto msg = m.instantiate<online_stereo_calibration::StereoCalibration>();
+    if (!msg) continue;
+    Vector12d p;
+    for (int i = 0; i < 12; ++i) p(i) = msg->parameters[i];
+    out.emplace_back(static_cast<std::int64_t>(msg->header.stamp.toNSec()), p);
+  }
+  return out;
+}
+
+/// The scenario fingerprint stored in a bag by `simulate`, or "" (no such topic, unreadable).
+inline std::string readScenarioFingerprint(const std::string& bag_path,
+                                           const DriveTopics& names = DriveTopics()) {
+  try {
+    rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
+    rosbag::View view(bag, rosbag::TopicQuery(names.scenario));
+    for (const rosbag::MessageInstance& m : view) {
+      const auto msg = m.instantiate<std_msgs::String>();
+      if (!msg) continue;
+      const std::string prefix = "fingerprint: ";
+      if (msg->data.rfind(prefix, 0) != 0) return "";
+      const auto end = msg->data.find('\n');
+      return msg->data.substr(prefix.size(),
+                              end == std::string::npos ? std::string::npos : end - prefix.size());
+    }
+  } catch (const std::exception&) {
+  }
+  return "";
+}
+
+}  // namespace osc::bag

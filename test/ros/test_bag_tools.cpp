@@ -1,0 +1,254 @@
+/// @file test_bag_tools.cpp
+/// @brief The bag tools without a ROS master: pose interpolation, stereo pairing, scenario
+/// files, and a short simulated drive (320x240, 60 frames) through the built `simulate` and
+/// `evaluate` executables: CSV columns, table, plots, RMSE recomputed from the CSVs, truth
+/// topic == reference.csv == truth.yaml.
+#include <unistd.h>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "../../src/tools/ros/bag_io.h"
+#include "online_stereo_calibration/tools/bag_evaluation.h"
+#include "online_stereo_calibration/tools/calibration_file.h"
+#include "online_stereo_calibration/tools/estimates_csv.h"
+#include "online_stereo_calibration/tools/pose_interpolation.h"
+#include "online_stereo_calibration/tools/scenario_file.h"
+
+namespace {
+
+Eigen::Isometry3d pose(double x, double y, double z, double roll, double pitch, double yaw) {
+  osc::Vector6d p;
+  p << x, y, z, roll, pitch, yaw;
+  return osc::poseFromParameters(p);
+}
+
+bool isFile(const std::string& path) { return std::ifstream(path).good(); }
+
+/// Directory of the running test binary (catkin puts the executables next to it).
+std::string executableDirectory() {
+  char buffer[4096];
+  const ssize_t n = readlink("/proc/self/exe", buffer, sizeof buffer - 1);
+  if (n <= 0) return ".";
+  std::string path(buffer, n);
+  return path.substr(0, path.find_last_of('/'));
+}
+
+/// Path of a built tool: next to the test binary or in the catkin devel lib folder.
+std::string findTool(const std::string& name) {
+  const std::string dir = executableDirectory();
+  for (const std::string& c : {dir + "/" + name, dir + "/../lib/online_stereo_calibration/" + name,
+                               dir + "/devel/lib/online_stereo_calibration/" + name,
+                               dir + "/../devel/lib/online_stereo_calibration/" + name}) {
+    if (access(c.c_str(), X_OK) == 0) return c;
+  }
+  return "";
+}
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+TEST(PoseInterpolation, LinearAndSlerpBetweenSamples) {
+  osc::PoseTrajectory trajectory;
+  trajectory.append(10.0, pose(0, 0, 0, 0, 0, 0));
+  trajectory.append(11.0, pose(2, -4, 1, 0, 0, 0.4));
+  trajectory.append(12.0, pose(2, -4, 1, 0.2, 0, 0.4));
+  const auto mid = trajectory.at(10.25);
+  ASSERT_TRUE(mid.has_value());
+  EXPECT_TRUE(mid->translation().isApprox(Eigen::Vector3d(0.5, -1.0, 0.25), 1e-12));
+  const osc::Vector6d p = osc::parametersFromPose(*mid);
+  EXPECT_NEAR(p(5), 0.1, 1e-12);  // a quarter of the yaw
+  EXPECT_NEAR(p(3), 0.0, 1e-12);
+  const auto later = trajectory.at(11.5);
+  ASSERT_TRUE(later.has_value());
+  EXPECT_NEAR(osc::parametersFromPose(*later)(3), 0.1, 1e-12);
+  EXPECT_TRUE(trajectory.at(11.0)->isApprox(pose(2, -4, 1, 0, 0, 0.4), 1e-12));
+  EXPECT_FALSE(trajectory.at(9.9).has_value());
+  EXPECT_FALSE(trajectory.at(12.1).has_value());
+  EXPECT_TRUE(trajectory.at(12.01, 0.02).has_value());
+
+  const auto motion = trajectory.motionBetween(10.0, 11.0);
+  ASSERT_TRUE(motion.has_value());
+  EXPECT_DOUBLE_EQ(motion->dt, 1.0);
+  EXPECT_TRUE(motion->T_prev_curr.isApprox(pose(2, -4, 1, 0, 0, 0.4), 1e-12));
+  EXPECT_FALSE(trajectory.motionBetween(11.0, 10.0).has_value());
+  EXPECT_THROW(trajectory.append(5.0, pose(0, 0, 0, 0, 0, 0)), std::invalid_argument);
+
+  trajectory.pruneBefore(11.5);
+  EXPECT_EQ(trajectory.size(), 2u);
+  EXPECT_TRUE(trajectory.at(11.5).has_value());
+}
+
+TEST(PoseInterpolation, ReadsTheEurocTumTrajectory) {
+  const std::string path =
+      std::string(OSC_SOURCE_DIR) + "/../shared/data/trajectories/euroc_V1_01_easy_rep103.tum";
+  if (!isFile(path)) GTEST_SKIP() << "no " << path;
+  const osc::PoseTrajectory trajectory = osc::readTumTrajectory(path);
+  EXPECT_GT(trajectory.size(), 2800u);
+  EXPECT_NEAR(trajectory.lastStamp() - trajectory.firstStamp(), 144.7, 1.0);
+  EXPECT_NEAR(trajectory.poses().front().pose.translation().x(), 0.878895, 1e-9);
+}
+
+TEST(StereoPairing, PairsExactStampsOnly) {
+  const auto pairs = osc::pairByExactStamp({10, 20, 30, 40, 40, 50}, {5, 20, 31, 40, 50, 60});
+  ASSERT_EQ(pairs.size(), 3u);
+  EXPECT_EQ(pairs[0], std::make_pair(std::size_t(1), std::size_t(1)));
+  EXPECT_EQ(pairs[1], std::make_pair(std::size_t(3), std::size_t(3)));
+  EXPECT_EQ(pairs[2], std::make_pair(std::size_t(5), std::size_t(4)));
+}
+
+TEST(ScenarioFile, ShippedScenariosParse) {
+  for (const std::string name : {"paper_offroad", "urban_planar", "drift", "mav_euroc"}) {
+    SCOPED_TRACE(name);
+    const std::string path = std::string(OSC_SOURCE_DIR) + "/config/scenarios/" + name + ".yaml";
+    if (name == "mav_euroc" && !isFile(std::string(OSC_SOURCE_DIR) + "/../shared/data/README.md")) {
+      continue;
+    }
+    const osc::SimulationScenario s = osc::readScenarioFile(path);
+    EXPECT_EQ(s.measurement.name, name);
+    EXPECT_TRUE(s.measurement.validate().empty());
+  }
+  const osc::SimulationScenario paper =
+      osc::readScenarioFile(std::string(OSC_SOURCE_DIR) + "/config/scenarios/paper_offroad.yaml");
+  EXPECT_TRUE(paper.measurement.truth.isApprox(osc::paperOffroadScenario().truth, 1e-12));
+  EXPECT_EQ(paper.measurement.step_frame, 774);
+}
+
+TEST(ScenarioFile, EurocRigFromSensorYaml) {
+  const std::string path = std::string(OSC_SOURCE_DIR) + "/config/scenarios/mav_euroc.yaml";
+  if (!isFile(std::string(OSC_SOURCE_DIR) + "/../shared/data/README.md")) GTEST_SKIP();
+  const osc::SimulationScenario s = osc::readScenarioFile(path);
+  EXPECT_EQ(s.measurement.left.width, 752);
+  EXPECT_DOUBLE_EQ(s.measurement.left.fx, 458.654);
+  EXPECT_EQ(s.measurement.left.distortion.size(), 4u);
+  EXPECT_NEAR(s.measurement.truth(7), -0.110, 0.002);  // yr = -baseline
+  ASSERT_TRUE(s.trajectory.has_value());
+}
+
+TEST(ScenarioFile, ErrorsNameTheKey) {
+  const auto message = [](const std::string& text) {
+    try {
+      osc::parseScenarioYaml(text, "test.yaml", ".");
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message("framez: 10\n").find("framez"), std::string::npos);
+  EXPECT_NE(message("motion: {sped: 3}\n").find("motion.sped"), std::string::npos);
+  EXPECT_NE(message("rate_hz: fast\n").find("rate_hz"), std::string::npos);
+  EXPECT_NE(message("truth: {vehicle_to_left: [1, 2]}\n").find("truth.vehicle_to_left"),
+            std::string::npos);
+  EXPECT_NE(message("rendering: {supersampling: 9}\n").find("rendering.supersampling"),
+            std::string::npos);
+  EXPECT_NE(message("frames: -3\n").find("frames"), std::string::npos);
+  EXPECT_NE(message("left_camera: {distortion_model: wavy}\n").find("left_camera.distortion_model"),
+            std::string::npos);
+}
+
+TEST(BagTools, SimulateThenEvaluateShortDrive) {
+  const std::string simulate = findTool("simulate");
+  const std::string evaluate = findTool("evaluate");
+  if (simulate.empty() || evaluate.empty()) {
+    GTEST_SKIP() << "simulate/evaluate not built (make simulate evaluate)";
+  }
+  char dir_template[] = "/tmp/osc_bag_tools_XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  {
+    std::ofstream scenario(dir + "/short.yaml");
+    scenario << "base: paper_offroad\nname: short\nframes: 60\nrate_hz: 10\nstep_frame: 30\n"
+                "left_camera: {width: 320, height: 240, fx: 300, fy: 300, cx: 159.5, cy: 119.5}\n"
+                "right_camera: {width: 320, height: 240, fx: 300, fy: 300, cx: 159.5, cy: 119.5}\n"
+                "rendering: {supersampling: 1}\n";
+  }
+  ASSERT_EQ(std::system((simulate + " --scenario " + dir + "/short.yaml --out " + dir + "/sim 2> " +
+                         dir + "/simulate.log")
+                            .c_str()),
+            0)
+      << readText(dir + "/simulate.log");
+  const std::string bag_path = dir + "/sim/drive.bag";
+  ASSERT_TRUE(isFile(bag_path));
+
+  // The truth topic, reference.csv and truth.yaml agree.
+  const auto reference = osc::readReferenceCsv(dir + "/sim/reference.csv");
+  ASSERT_EQ(reference.size(), 60u);
+  {
+    rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
+    const auto truth = osc::bag::readCalibrationTopic(bag, "/ground_truth/calibration");
+    ASSERT_EQ(truth.size(), 60u);
+    for (std::size_t k = 0; k < truth.size(); ++k) {
+      EXPECT_NEAR(truth[k].first * 1e-9, reference[k].stamp, 1e-6);
+      EXPECT_TRUE(truth[k].second.isApprox(reference[k].parameters, 1e-12)) << "frame " << k;
+    }
+    EXPECT_GT(reference[30].parameters(5) - reference[29].parameters(5), 0.17);  // the step
+    const osc::PoseTrajectory odom = osc::bag::readOdometry(bag, "/odom");
+    EXPECT_GE(odom.lastStamp(), reference.back().stamp);
+    EXPECT_LE(odom.firstStamp(), reference.front().stamp);
+  }
+  const osc::CalibrationFile truth_file = osc::readCalibrationFile(dir + "/sim/truth.yaml");
+  EXPECT_TRUE(truth_file.extrinsics.toParameters().isApprox(reference[0].parameters, 1e-12));
+  const osc::CalibrationFile guess = osc::readCalibrationFile(dir + "/sim/initial_guess.yaml");
+  EXPECT_NEAR(guess.extrinsics.toParameters()(0) - reference[0].parameters(0), 0.5, 1e-9);
+
+  // The cache: a second run does nothing.
+  ASSERT_EQ(std::system((simulate + " --scenario " + dir + "/short.yaml --out " + dir + "/sim 2> " +
+                         dir + "/simulate2.log")
+                            .c_str()),
+            0);
+  EXPECT_NE(readText(dir + "/simulate2.log").find("up to date"), std::string::npos);
+
+  ASSERT_EQ(std::system((evaluate + " --bag " + bag_path + " --out " + dir +
+                         "/eval --truth-topic /ground_truth/calibration --window 40 59 > " + dir +
+                         "/evaluate.log 2>&1")
+                            .c_str()),
+            0)
+      << readText(dir + "/evaluate.log");
+  const std::string csv = readText(dir + "/eval/estimates.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), osc::estimatesCsvHeader());
+  const auto estimates = osc::readEstimatesCsv(dir + "/eval/estimates.csv");
+  EXPECT_GE(estimates.size(), 55u);
+  EXPECT_TRUE(isFile(dir + "/eval/reference.csv"));
+  for (const std::string png : {"vehicle_to_left.png", "left_to_right.png", "errors.png"}) {
+    EXPECT_TRUE(isFile(dir + "/eval/" + png)) << png;
+  }
+
+  // RMSE of xl and of yaw_l over frames 40-59 recomputed from the CSVs = the table's.
+  const std::string table = readText(dir + "/eval/table.txt");
+  const auto tableRmse = [&](const std::string& name) {
+    const auto line_start = table.find("\n" + name + " ");
+    EXPECT_NE(line_start, std::string::npos) << name;
+    std::istringstream line(table.substr(line_start + 1));
+    std::string label, unit;
+    double rmse = NAN;
+    line >> label >> unit >> rmse;
+    return rmse;
+  };
+  const auto ownRmse = [&](int p) {
+    double sum = 0;
+    int n = 0;
+    for (const auto& e : estimates) {
+      if (e.frame < 40 || e.frame > 59) continue;
+      double error = e.parameters(p) - reference[e.frame].parameters(p);
+      if (p % 6 >= 3) error = std::remainder(error, 2 * M_PI);
+      sum += error * error;
+      ++n;
+    }
+    return std::sqrt(sum / n);
+  };
+  const double xl = ownRmse(0), yaw_l = ownRmse(5) * 180.0 / M_PI;
+  EXPECT_NEAR(tableRmse("xl"), xl, 1e-5 + 1e-4 * xl);
+  EXPECT_NEAR(tableRmse("yaw_l"), yaw_l, 1e-5 + 1e-4 * yaw_l);
+  EXPECT_NE(table.find("time per frame: median"), std::string::npos);
+  EXPECT_NE(table.find("mean NEES"), std::string::npos);
+  std::system(("rm -rf " + dir).c_str());
+}
