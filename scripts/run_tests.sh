@@ -21,6 +21,12 @@ if [[ -f /opt/ros/noetic/setup.bash ]]; then
   set -u
 fi
 
+# ROS's test tools (rostest, roslaunch-check) run 'python3' from PATH: make it the system
+# interpreter that has the ROS modules, not a pyenv/conda/venv one first on PATH.
+if [[ -x /usr/bin/python3 ]]; then
+  export PATH="/usr/bin:$PATH"
+fi
+
 log="$(mktemp)"
 trap 'rm -f "$log"' EXIT
 # CMake 3.16 (Ubuntu 20.04) has no 'ctest --test-dir': run from inside the build directory.

@@ -1,0 +1,56 @@
+/// @file calibration_diagnostics.h
+/// @brief /diagnostics through diagnostic_updater: a frequency monitor per input and one
+/// aggregated calibration status with its reasons (not converged, too few points, dropped
+/// pairs, stamp skew, motion gaps, 3-sigma of every parameter). Thread-safe.
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+
+#include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
+#include "online_stereo_calibration/ros/ros_config.h"
+
+namespace online_stereo_calibration {
+
+/// Counts events and summarises them once per diagnostics period.
+class CalibrationDiagnostics {
+ public:
+  CalibrationDiagnostics(ros::NodeHandle& nh, ros::NodeHandle& private_nh, const RosConfig& config);
+
+  void tickPair();       ///< a synchronised image pair arrived
+  void tickProcessed();  ///< a pair went through the estimator
+  void tickOdom();       ///< a motion sample arrived
+  /// A problem with the input; counted under @p kind and kept as the latest message.
+  void recordProblem(const std::string& kind, const std::string& message);
+  /// The estimate after a processed pair and its StereoCalibration state.
+  void recordEstimate(const osc::CalibrationEstimate& estimate, uint8_t state);
+  /// Publishes now if the period elapsed (call from a timer).
+  void update();
+  /// Latest value of a counter (tests, logging).
+  int count(const std::string& kind) const;
+
+ private:
+  void produceStatus(diagnostic_updater::DiagnosticStatusWrapper& status);
+
+  RosConfig config_;
+  double min_rate_;
+  double max_rate_;
+  diagnostic_updater::Updater updater_;
+  diagnostic_updater::FrequencyStatus pair_frequency_;
+  diagnostic_updater::FrequencyStatus processed_frequency_;
+  diagnostic_updater::FrequencyStatus odom_frequency_;
+  mutable std::mutex mutex_;
+  std::vector<std::pair<std::string, int>> counts_;
+  std::vector<std::pair<std::string, int>> counts_at_last_report_;
+  std::string last_problem_;
+  bool have_estimate_ = false;
+  osc::CalibrationEstimate estimate_;
+  uint8_t state_ = 0;
+};
+
+}  // namespace online_stereo_calibration

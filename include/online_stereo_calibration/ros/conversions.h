@@ -1,0 +1,47 @@
+/// @file conversions.h
+/// @brief Pure conversions between ROS messages and the core's plain types (no node handle,
+/// no master): CameraInfo -> CameraIntrinsics, poses, transforms, and pose interpolation.
+#pragma once
+
+#include <string>
+
+#include <geometry_msgs/Pose.h>
+#include <geometry_msgs/Transform.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <Eigen/Geometry>
+
+#include "online_stereo_calibration/core/geometry/camera_model.h"
+
+namespace online_stereo_calibration {
+
+/// K, D, size and distortion model of a CameraInfo (the raw camera's intrinsics).
+/// @throws std::invalid_argument naming the problem (uncalibrated K, unknown model, wrong
+/// number of coefficients, non-positive size).
+osc::CameraIntrinsics intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info);
+
+/// True if two intrinsics differ in any field (camera_info changed).
+bool intrinsicsDiffer(const osc::CameraIntrinsics& a, const osc::CameraIntrinsics& b);
+
+/// geometry_msgs/Pose -> isometry; the quaternion is normalised.
+Eigen::Isometry3d isometryFromPose(const geometry_msgs::Pose& pose);
+/// geometry_msgs/Transform -> isometry; the quaternion is normalised.
+Eigen::Isometry3d isometryFromTransform(const geometry_msgs::Transform& transform);
+/// isometry -> geometry_msgs/Transform.
+geometry_msgs::Transform transformFromIsometry(const Eigen::Isometry3d& pose);
+
+/// True if every field of the pose is finite and the quaternion has a usable norm.
+bool isFinitePose(const geometry_msgs::Pose& pose);
+
+/// A pose with its time (s).
+struct StampedPose {
+  double stamp = 0.0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+};
+
+/// The pose at @p stamp between @p before and @p after: translation linear, rotation SLERP
+/// (shortest arc). @p stamp may be outside [before, after] (extrapolation); equal stamps
+/// return @p before.
+Eigen::Isometry3d interpolatePose(const StampedPose& before, const StampedPose& after,
+                                  double stamp);
+
+}  // namespace online_stereo_calibration

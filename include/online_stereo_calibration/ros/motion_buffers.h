@@ -1,0 +1,79 @@
+/// @file motion_buffers.h
+/// @brief Time-indexed buffers of vehicle poses (odometry) and angular rates (IMU) that
+/// answer "the motion between two image stamps". Pure C++, no ROS: unit-tested without a
+/// master.
+#pragma once
+
+#include <deque>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "online_stereo_calibration/ros/conversions.h"
+
+namespace online_stereo_calibration {
+
+/// Why a lookup gave no answer.
+enum class LookupStatus {
+  kOk,      ///< answered
+  kNotYet,  ///< the stamp is newer than the newest sample: wait for more data
+  kTooOld,  ///< the stamp is older than the oldest sample kept
+  kGap,     ///< the bracketing samples are further apart than the allowed gap
+  kEmpty,   ///< no sample at all yet
+};
+
+/// Human-readable name of a LookupStatus.
+std::string lookupStatusName(LookupStatus status);
+
+/// Vehicle poses in a fixed frame, sorted by stamp, interpolated at arbitrary stamps
+/// (linear + SLERP). Not thread-safe.
+class PoseBuffer {
+ public:
+  /// @param history seconds of samples kept behind the newest one.
+  /// @param max_gap largest allowed time between two bracketing samples (s).
+  PoseBuffer(double history, double max_gap) : history_(history), max_gap_(max_gap) {}
+
+  /// Adds a sample. Returns false (sample ignored) if the pose is not finite or the stamp
+  /// is not newer than the newest sample (duplicate or out of order).
+  bool add(const StampedPose& sample);
+
+  /// The pose at @p stamp, interpolated between the two samples bracketing it.
+  LookupStatus poseAt(double stamp, Eigen::Isometry3d* pose) const;
+
+  /// Drops every sample (time went backwards).
+  void clear() { samples_.clear(); }
+  bool empty() const { return samples_.empty(); }
+  double newestStamp() const { return samples_.empty() ? 0.0 : samples_.back().stamp; }
+
+ private:
+  double history_;
+  double max_gap_;
+  std::deque<StampedPose> samples_;
+};
+
+/// Angular rates (rad/s, vehicle frame) integrated into a rotation between two stamps,
+/// each rate held constant until the next sample (zero-order hold). Not thread-safe.
+class GyroIntegrator {
+ public:
+  GyroIntegrator(double history, double max_gap) : history_(history), max_gap_(max_gap) {}
+
+  /// Adds a sample; false if not finite or not newer than the newest sample.
+  bool add(double stamp, const Eigen::Vector3d& angular_rate);
+
+  /// R_prev_curr: the rotation of the vehicle at @p to expressed in the vehicle frame at
+  /// @p from (from < to).
+  LookupStatus rotationBetween(double from, double to, Eigen::Matrix3d* rotation) const;
+
+  void clear() { samples_.clear(); }
+
+ private:
+  struct Sample {
+    double stamp;
+    Eigen::Vector3d rate;
+  };
+  double history_;
+  double max_gap_;
+  std::deque<Sample> samples_;
+};
+
+}  // namespace online_stereo_calibration

@@ -1,0 +1,57 @@
+/// @file motion_source.h
+/// @brief The vehicle motion between two image stamps from odometry (nav_msgs/Odometry,
+/// interpolated) or tf (fixed frame -> vehicle frame), optionally with the rotation from
+/// an IMU's angular rate. Thread-safe: callbacks on the nodelet's queue, lookups from the
+/// worker thread.
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <mutex>
+
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <sensor_msgs/Imu.h>
+#include <tf2_ros/buffer.h>
+
+#include "online_stereo_calibration/core/estimator/types.h"
+#include "online_stereo_calibration/ros/motion_buffers.h"
+#include "online_stereo_calibration/ros/ros_config.h"
+
+namespace online_stereo_calibration {
+
+/// Subscribes to what the configuration asks for and answers motion lookups.
+class MotionSource {
+ public:
+  /// @param tf a buffer fed by a listener (used for motion_source tf).
+  MotionSource(ros::NodeHandle& nh, const RosConfig& config, tf2_ros::Buffer* tf);
+
+  /// T_prev_curr and dt between two stamps (prev < curr).
+  LookupStatus motionBetween(const ros::Time& previous, const ros::Time& current,
+                             osc::MotionIncrement* motion);
+  /// Whether the vehicle pose at @p stamp is known.
+  LookupStatus poseAvailable(const ros::Time& stamp);
+  /// Forgets every sample (time went backwards).
+  void clear();
+
+  /// Called for each accepted odometry / imu sample (frequency diagnostics).
+  std::function<void()> on_odom;
+  std::function<void()> on_imu;
+  /// Samples ignored (non-finite, duplicated or out-of-order stamps).
+  std::atomic<int> rejected_samples{0};
+
+ private:
+  void odomCallback(const nav_msgs::Odometry::ConstPtr& message);
+  void imuCallback(const sensor_msgs::Imu::ConstPtr& message);
+  LookupStatus poseAt(const ros::Time& stamp, Eigen::Isometry3d* pose);
+
+  RosConfig config_;
+  tf2_ros::Buffer* tf_;
+  std::mutex mutex_;
+  PoseBuffer poses_;
+  GyroIntegrator gyro_;
+  ros::Subscriber odom_sub_;
+  ros::Subscriber imu_sub_;
+};
+
+}  // namespace online_stereo_calibration

@@ -1,0 +1,447 @@
+/// @file calibration_nodelet.cpp
+/// @brief CalibrationNodelet: synchronisation, worker thread, services; adapts only.
+#include "online_stereo_calibration/ros/calibration_nodelet.h"
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+
+#include <cv_bridge/cv_bridge.h>
+#include <sensor_msgs/image_encodings.h>
+#include <pluginlib/class_list_macros.hpp>
+
+#include "online_stereo_calibration/tools/calibration_file.h"
+
+namespace online_stereo_calibration {
+namespace {
+
+/// The tangent covariance whose parameter covariance is diag(sigmas^2).
+osc::Matrix12d tangentCovarianceFromSigmas(const osc::StereoExtrinsics& extrinsics,
+                                           const osc::Vector12d& sigmas) {
+  const osc::Matrix12d J = osc::parameterJacobian(extrinsics);
+  const osc::Matrix12d J_inv = J.inverse();
+  osc::Matrix12d P = osc::Matrix12d::Zero();
+  P.diagonal() = sigmas.cwiseProduct(sigmas);
+  osc::Matrix12d tangent = J_inv * P * J_inv.transpose();
+  return 0.5 * (tangent + tangent.transpose());
+}
+
+/// Image -> cv::Mat in an encoding the pipeline takes; empty with @p error if unsupported.
+cv_bridge::CvImageConstPtr toPipelineImage(const sensor_msgs::ImageConstPtr& image,
+                                           std::string* error) {
+  namespace enc = sensor_msgs::image_encodings;
+  try {
+    const std::string& e = image->encoding;
+    if (e == enc::MONO8 || e == enc::MONO16 || e == enc::BGR8 || e == enc::BGRA8) {
+      return cv_bridge::toCvShare(image);
+    }
+    if (e == enc::RGB8) return cv_bridge::toCvShare(image, enc::BGR8);
+    if (e == enc::RGBA8) return cv_bridge::toCvShare(image, enc::BGRA8);
+    *error = "unsupported image encoding '" + e + "'";
+  } catch (const cv_bridge::Exception& exception) {
+    *error = std::string("cv_bridge: ") + exception.what();
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+CalibrationNodelet::~CalibrationNodelet() {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    stopping_ = true;
+  }
+  queue_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+  if (!config_.ros.calibration_file.empty()) {
+    std::string error;
+    if (!saveCalibration(&error) && !error.empty()) {
+      NODELET_ERROR("online_stereo_calibration: saving on shutdown failed: %s", error.c_str());
+    }
+  }
+}
+
+void CalibrationNodelet::onInit() {
+  ros::NodeHandle& nh = getNodeHandle();
+  ros::NodeHandle& pnh = getPrivateNodeHandle();
+  std::vector<std::string> problems;
+  config_ = loadNodeConfig(pnh, &problems);
+  if (problems.empty()) {
+    try {
+      loadInitialGuess();
+    } catch (const std::exception& e) {
+      problems.push_back(e.what());
+    }
+  }
+  if (!problems.empty()) {
+    std::ostringstream out;
+    out << "invalid configuration (" << problems.size() << " problems):";
+    for (const std::string& problem : problems) out << "\n  - " << problem;
+    NODELET_FATAL("%s", out.str().c_str());
+    config_.ros.calibration_file.clear();  // nothing to save
+    throw std::runtime_error(out.str());
+  }
+
+  tf_buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(config_.ros.motion_history + 5.0));
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh);
+  diagnostics_ = std::make_unique<CalibrationDiagnostics>(nh, pnh, config_.ros);
+  motion_ = std::make_unique<MotionSource>(nh, config_.ros, tf_buffer_.get());
+  motion_->on_odom = [this]() { diagnostics_->tickOdom(); };
+  output_ = std::make_unique<OutputPublisher>(nh, pnh, config_.ros.publish_tf);
+
+  reset_srv_ = pnh.advertiseService("reset", &CalibrationNodelet::resetService, this);
+  save_srv_ = pnh.advertiseService("save_calibration", &CalibrationNodelet::saveService, this);
+  diagnostics_timer_ = nh.createTimer(ros::Duration(0.5),
+                                      [this](const ros::TimerEvent&) { diagnostics_->update(); });
+  if (config_.ros.save_interval > 0.0 && !config_.ros.calibration_file.empty()) {
+    save_timer_ =
+        nh.createTimer(ros::Duration(config_.ros.save_interval), [this](const ros::TimerEvent&) {
+          std::string error;
+          if (!saveCalibration(&error) && !error.empty()) {
+            NODELET_WARN("periodic save failed: %s", error.c_str());
+          }
+        });
+  }
+
+  worker_ = std::thread(&CalibrationNodelet::workerLoop, this);
+
+  it_ = std::make_unique<image_transport::ImageTransport>(nh);
+  const int q = config_.ros.queue_size;
+  left_sub_.subscribe(*it_, "left/image_raw", q);
+  right_sub_.subscribe(*it_, "right/image_raw", q);
+  left_info_sub_.subscribe(nh, "left/camera_info", q);
+  right_info_sub_.subscribe(nh, "right/camera_info", q);
+  if (config_.ros.approximate_sync) {
+    approximate_sync_ = std::make_unique<message_filters::Synchronizer<ApproximatePolicy>>(
+        ApproximatePolicy(q), left_sub_, left_info_sub_, right_sub_, right_info_sub_);
+    approximate_sync_->registerCallback(&CalibrationNodelet::pairCallback, this);
+  } else {
+    exact_sync_ = std::make_unique<message_filters::Synchronizer<ExactPolicy>>(
+        ExactPolicy(q), left_sub_, left_info_sub_, right_sub_, right_info_sub_);
+    exact_sync_->registerCallback(&CalibrationNodelet::pairCallback, this);
+  }
+  NODELET_INFO("online_stereo_calibration: ready (vehicle frame %s, %s sync)",
+               config_.ros.vehicle_frame.c_str(),
+               config_.ros.approximate_sync ? "approximate" : "exact");
+}
+
+void CalibrationNodelet::loadInitialGuess() {
+  const RosConfig& ros_config = config_.ros;
+  if (ros_config.resume) {
+    std::ifstream probe(ros_config.calibration_file);
+    if (probe.good()) {
+      const osc::CalibrationFile file = osc::readCalibrationFile(ros_config.calibration_file);
+      initial_guess_ = file.extrinsics;
+      if (file.sigmas) {
+        initial_covariance_ = tangentCovarianceFromSigmas(file.extrinsics, *file.sigmas);
+      }
+      NODELET_INFO("online_stereo_calibration: resuming from %s",
+                   ros_config.calibration_file.c_str());
+      return;
+    }
+    NODELET_WARN("online_stereo_calibration: resume: %s does not exist, using the initial guess",
+                 ros_config.calibration_file.c_str());
+  }
+  switch (ros_config.initial_guess_source) {
+    case InitialGuessSource::kParameters: {
+      osc::Vector12d parameters;
+      parameters << ros_config.vehicle_to_left, ros_config.left_to_right;
+      initial_guess_ = osc::StereoExtrinsics::fromParameters(parameters);
+      break;
+    }
+    case InitialGuessSource::kFile: {
+      const osc::CalibrationFile file = osc::readCalibrationFile(ros_config.initial_guess_file);
+      initial_guess_ = file.extrinsics;
+      if (file.sigmas) {
+        initial_covariance_ = tangentCovarianceFromSigmas(file.extrinsics, *file.sigmas);
+      }
+      break;
+    }
+    case InitialGuessSource::kTf:
+      break;  // looked up at the first pair, when the optical frames are known
+  }
+}
+
+void CalibrationNodelet::pairCallback(const sensor_msgs::ImageConstPtr& left,
+                                      const sensor_msgs::CameraInfoConstPtr& left_info,
+                                      const sensor_msgs::ImageConstPtr& right,
+                                      const sensor_msgs::CameraInfoConstPtr& right_info) {
+  diagnostics_->tickPair();
+  bool dropped = false;
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    queue_.push_back({left, right, left_info, right_info});
+    while (static_cast<int>(queue_.size()) > config_.ros.processing_queue_size) {
+      queue_.pop_front();
+      ++dropped_pairs_;
+      dropped = true;
+    }
+  }
+  queue_cv_.notify_one();
+  if (dropped) {
+    diagnostics_->recordProblem("dropped pairs", "processing fell behind: oldest pair dropped");
+    NODELET_WARN_THROTTLE(
+        5.0, "online_stereo_calibration: processing fell behind, %d pairs dropped", dropped_pairs_);
+  }
+}
+
+void CalibrationNodelet::workerLoop() {
+  while (true) {
+    StereoPair pair;
+    {
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      queue_cv_.wait(lock, [this]() { return stopping_ || !queue_.empty(); });
+      if (stopping_) return;
+      pair = queue_.front();
+      queue_.pop_front();
+    }
+    try {
+      processPair(pair);
+    } catch (const std::exception& e) {
+      diagnostics_->recordProblem("processing errors", e.what());
+      NODELET_ERROR_THROTTLE(5.0, "online_stereo_calibration: pair skipped: %s", e.what());
+    }
+  }
+}
+
+bool CalibrationNodelet::preparePipeline(const StereoPair& pair) {
+  osc::CameraIntrinsics left, right;
+  try {
+    left = intrinsicsFromCameraInfo(*pair.left_info);
+    right = intrinsicsFromCameraInfo(*pair.right_info);
+  } catch (const std::exception& e) {
+    diagnostics_->recordProblem("bad camera_info", e.what());
+    NODELET_ERROR_THROTTLE(5.0, "online_stereo_calibration: pair skipped, bad camera_info: %s",
+                           e.what());
+    return false;
+  }
+  if (left.width != right.width || left.height != right.height || left.model != right.model) {
+    diagnostics_->recordProblem("left/right camera_info disagree",
+                                "left and right camera_info differ in size or distortion model");
+    NODELET_WARN_THROTTLE(10.0,
+                          "online_stereo_calibration: left (%dx%d, %s) and right (%dx%d, %s) "
+                          "camera_info differ in size or model",
+                          left.width, left.height, osc::distortionModelName(left.model).c_str(),
+                          right.width, right.height, osc::distortionModelName(right.model).c_str());
+  }
+  if (pipeline_ && !intrinsicsDiffer(left, left_intrinsics_) &&
+      !intrinsicsDiffer(right, right_intrinsics_)) {
+    return true;
+  }
+  frames_.vehicle = config_.ros.vehicle_frame;
+  frames_.left_optical = config_.ros.left_optical_frame.empty() ? pair.left->header.frame_id
+                                                                : config_.ros.left_optical_frame;
+  frames_.right_optical = config_.ros.right_optical_frame.empty() ? pair.right->header.frame_id
+                                                                  : config_.ros.right_optical_frame;
+  osc::StereoExtrinsics guess = initial_guess_;
+  std::optional<osc::Matrix12d> covariance = initial_covariance_;
+  if (pipeline_) {
+    NODELET_WARN(
+        "online_stereo_calibration: camera_info changed, restarting the front end "
+        "(calibration kept)");
+    const osc::CalibrationEstimate estimate = pipeline_->estimate();
+    guess = estimate.extrinsics;
+    covariance = estimate.tangent_covariance;
+  } else if (config_.ros.initial_guess_source == InitialGuessSource::kTf && !config_.ros.resume) {
+    try {
+      const ros::Duration timeout(config_.ros.tf_guess_timeout);
+      const Eigen::Isometry3d T_veh_lopt = isometryFromTransform(
+          tf_buffer_->lookupTransform(frames_.vehicle, frames_.left_optical, ros::Time(0), timeout)
+              .transform);
+      const Eigen::Isometry3d T_lopt_ropt = isometryFromTransform(
+          tf_buffer_
+              ->lookupTransform(frames_.left_optical, frames_.right_optical, ros::Time(0), timeout)
+              .transform);
+      const Eigen::Isometry3d T_body_opt = osc::bodyFromOptical();
+      guess.T_veh_caml = T_veh_lopt * T_body_opt.inverse();
+      guess.T_caml_camr = T_body_opt * T_lopt_ropt * T_body_opt.inverse();
+    } catch (const std::exception& e) {
+      diagnostics_->recordProblem("no initial guess", e.what());
+      NODELET_ERROR_THROTTLE(5.0, "online_stereo_calibration: initial guess from tf: %s", e.what());
+      return false;
+    }
+  }
+  auto pipeline = std::make_unique<osc::CalibrationPipeline>(config_.filter, config_.front_end,
+                                                             left, right, guess);
+  if (covariance) pipeline->reset(guess, *covariance);
+  std::lock_guard<std::mutex> lock(pipeline_mutex_);
+  pipeline_ = std::move(pipeline);
+  left_intrinsics_ = left;
+  right_intrinsics_ = right;
+  last_stamp_ = ros::Time();
+  return true;
+}
+
+bool CalibrationNodelet::waitForMotion(const ros::Time& stamp, osc::MotionIncrement* motion) {
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.ros.motion_wait);
+  LookupStatus status = LookupStatus::kEmpty;
+  while (true) {
+    if (last_stamp_.isZero()) {
+      status = motion_->poseAvailable(stamp);
+    } else {
+      status = motion_->motionBetween(last_stamp_, stamp, motion);
+    }
+    if (status == LookupStatus::kOk) return true;
+    const bool may_come = status == LookupStatus::kNotYet || status == LookupStatus::kEmpty;
+    if (!may_come || std::chrono::steady_clock::now() > deadline) break;
+    {
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      if (queue_cv_.wait_for(lock, std::chrono::milliseconds(5), [this]() { return stopping_; })) {
+        return false;
+      }
+    }
+  }
+  diagnostics_->recordProblem("motion gaps", "no motion for the pair at " +
+                                                 std::to_string(stamp.toSec()) + ": " +
+                                                 lookupStatusName(status));
+  NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: pair at %.6f skipped: %s", stamp.toSec(),
+                        lookupStatusName(status).c_str());
+  return false;
+}
+
+void CalibrationNodelet::processPair(const StereoPair& pair) {
+  const ros::Time stamp = pair.left->header.stamp;
+  const double skew = std::abs((pair.left->header.stamp - pair.right->header.stamp).toSec());
+  if (skew > config_.ros.max_stamp_skew) {
+    diagnostics_->recordProblem("stamp skew",
+                                "left/right stamps differ by " + std::to_string(skew) + " s");
+    NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: left/right stamps differ by %.6f s",
+                          skew);
+  }
+  if (!last_stamp_.isZero() && stamp <= last_stamp_) {
+    if (stamp == last_stamp_) {
+      diagnostics_->recordProblem("duplicated stamps", "pair with the stamp of the previous one");
+      NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: duplicated pair stamp %.6f skipped",
+                            stamp.toSec());
+      return;
+    }
+    diagnostics_->recordProblem("time went backwards",
+                                "pair stamp " + std::to_string(stamp.toSec()) + " before " +
+                                    std::to_string(last_stamp_.toSec()));
+    NODELET_WARN("online_stereo_calibration: time went backwards (%.6f < %.6f): tracks reset",
+                 stamp.toSec(), last_stamp_.toSec());
+    {
+      std::lock_guard<std::mutex> lock(pipeline_mutex_);
+      if (pipeline_) pipeline_->resetTracking();
+    }
+    motion_->clear();
+    last_stamp_ = ros::Time();
+  }
+  if (!preparePipeline(pair)) return;
+
+  std::string error;
+  cv_bridge::CvImageConstPtr left = toPipelineImage(pair.left, &error);
+  cv_bridge::CvImageConstPtr right = left ? toPipelineImage(pair.right, &error) : nullptr;
+  if (!left || !right) {
+    diagnostics_->recordProblem("rejected images", error);
+    NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: pair skipped: %s", error.c_str());
+    return;
+  }
+  osc::MotionIncrement motion;
+  if (!waitForMotion(stamp, &motion)) return;
+
+  osc::PipelineResult result;
+  std::vector<osc::PointEstimate> points;
+  cv::Mat debug;
+  {
+    std::lock_guard<std::mutex> lock(pipeline_mutex_);
+    result = pipeline_->process(left->image, right->image, motion);
+    if (result.processed) {
+      points = pipeline_->points();
+      if (output_->debugImageWanted()) debug = pipeline_->debugImage();
+    }
+  }
+  if (!result.processed) {
+    diagnostics_->recordProblem("rejected images", result.status);
+    NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: pair skipped: %s",
+                          result.status.c_str());
+    return;
+  }
+  last_stamp_ = stamp;
+  diagnostics_->tickProcessed();
+  if (result.estimator.motion_rejected) {
+    diagnostics_->recordProblem("motion rejected", result.status);
+  }
+  for (const std::string& warning : result.estimator.warnings) {
+    NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: %s", warning.c_str());
+  }
+  const bool jump = result.estimator.step.jump != osc::JumpBlock::kNone;
+  const uint8_t state = calibrationState(result.estimate, jump, config_.ros.min_tracked_points,
+                                         config_.ros.converged_translation_3sigma,
+                                         config_.ros.converged_rotation_3sigma);
+  const StereoCalibration message =
+      makeCalibrationMessage(result.estimate, stamp, frames_, state, result.processing_time);
+  diagnostics_->recordEstimate(result.estimate, state);
+  if (!output_->publishCalibration(message, result.estimate)) {
+    diagnostics_->recordProblem("non-finite estimate", "estimate not published");
+    NODELET_ERROR_THROTTLE(5.0, "online_stereo_calibration: non-finite estimate not published");
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(pipeline_mutex_);
+    last_estimate_ = result.estimate;
+    last_saved_stamp_ = stamp;
+  }
+  std_msgs::Header header;
+  header.stamp = stamp;
+  header.frame_id = frames_.left_optical;
+  output_->publishPoints(points, header);
+  if (!debug.empty()) output_->publishDebugImage(debug, header);
+}
+
+bool CalibrationNodelet::resetService(std_srvs::Trigger::Request&,
+                                      std_srvs::Trigger::Response& response) {
+  std::lock_guard<std::mutex> lock(pipeline_mutex_);
+  if (pipeline_) {
+    if (initial_covariance_) {
+      pipeline_->reset(initial_guess_, *initial_covariance_);
+    } else {
+      pipeline_->reset(initial_guess_);
+    }
+  }
+  last_estimate_.reset();
+  response.success = true;
+  response.message = "calibration reset to the initial guess";
+  NODELET_INFO("online_stereo_calibration: %s", response.message.c_str());
+  return true;
+}
+
+bool CalibrationNodelet::saveService(std_srvs::Trigger::Request&,
+                                     std_srvs::Trigger::Response& response) {
+  std::string error;
+  response.success = saveCalibration(&error);
+  response.message = response.success ? "saved to " + config_.ros.calibration_file : error;
+  return true;
+}
+
+bool CalibrationNodelet::saveCalibration(std::string* error) {
+  if (config_.ros.calibration_file.empty()) {
+    *error = "calibration_file is not set";
+    return false;
+  }
+  osc::CalibrationFile file;
+  {
+    std::lock_guard<std::mutex> lock(pipeline_mutex_);
+    if (!last_estimate_) {
+      *error = "";
+      if (!pipeline_) *error = "no estimate yet";
+      if (!pipeline_) return false;
+      last_estimate_ = pipeline_->estimate();
+    }
+    file.extrinsics = last_estimate_->extrinsics;
+    file.sigmas = last_estimate_->sigmas();
+    file.stamp = last_saved_stamp_.toSec();
+  }
+  try {
+    osc::writeCalibrationFileAtomic(config_.ros.calibration_file, file);
+  } catch (const std::exception& e) {
+    *error = e.what();
+    return false;
+  }
+  return true;
+}
+
+}  // namespace online_stereo_calibration
+
+PLUGINLIB_EXPORT_CLASS(online_stereo_calibration::CalibrationNodelet, nodelet::Nodelet)

@@ -1,0 +1,104 @@
+/// @file conversions.cpp
+/// @brief Pure message <-> core conversions.
+#include "online_stereo_calibration/ros/conversions.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace online_stereo_calibration {
+
+osc::CameraIntrinsics intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info) {
+  osc::CameraIntrinsics intrinsics;
+  if (info.width == 0 || info.height == 0) {
+    throw std::invalid_argument("camera_info has zero width or height (" +
+                                std::to_string(info.width) + "x" + std::to_string(info.height) +
+                                ")");
+  }
+  if (!(info.K[0] > 0.0) || !(info.K[4] > 0.0) || !std::isfinite(info.K[0]) ||
+      !std::isfinite(info.K[4]) || !std::isfinite(info.K[2]) || !std::isfinite(info.K[5])) {
+    throw std::invalid_argument("camera_info is uncalibrated (K[0] or K[4] not positive)");
+  }
+  intrinsics.width = static_cast<int>(info.width);
+  intrinsics.height = static_cast<int>(info.height);
+  intrinsics.fx = info.K[0];
+  intrinsics.fy = info.K[4];
+  intrinsics.cx = info.K[2];
+  intrinsics.cy = info.K[5];
+  intrinsics.model = osc::distortionModelFromName(info.distortion_model);
+  intrinsics.distortion.assign(info.D.begin(), info.D.end());
+  // An all-zero D means no distortion, whatever its length; "none" takes no coefficients.
+  bool all_zero = true;
+  for (double d : intrinsics.distortion) all_zero = all_zero && d == 0.0;
+  if (intrinsics.model == osc::DistortionModel::kNone && all_zero) intrinsics.distortion.clear();
+  // The core validates the number of coefficients and finiteness.
+  osc::CameraModel check(intrinsics);
+  (void)check;
+  return intrinsics;
+}
+
+bool intrinsicsDiffer(const osc::CameraIntrinsics& a, const osc::CameraIntrinsics& b) {
+  return a.width != b.width || a.height != b.height || a.fx != b.fx || a.fy != b.fy ||
+         a.cx != b.cx || a.cy != b.cy || a.model != b.model || a.distortion != b.distortion;
+}
+
+Eigen::Isometry3d isometryFromPose(const geometry_msgs::Pose& pose) {
+  Eigen::Quaterniond q(pose.orientation.w, pose.orientation.x, pose.orientation.y,
+                       pose.orientation.z);
+  q.normalize();
+  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
+  result.linear() = q.toRotationMatrix();
+  result.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
+  return result;
+}
+
+Eigen::Isometry3d isometryFromTransform(const geometry_msgs::Transform& transform) {
+  geometry_msgs::Pose pose;
+  pose.position.x = transform.translation.x;
+  pose.position.y = transform.translation.y;
+  pose.position.z = transform.translation.z;
+  pose.orientation = transform.rotation;
+  return isometryFromPose(pose);
+}
+
+geometry_msgs::Transform transformFromIsometry(const Eigen::Isometry3d& pose) {
+  geometry_msgs::Transform transform;
+  transform.translation.x = pose.translation().x();
+  transform.translation.y = pose.translation().y();
+  transform.translation.z = pose.translation().z();
+  Eigen::Quaterniond q(pose.linear());
+  q.normalize();
+  transform.rotation.w = q.w();
+  transform.rotation.x = q.x();
+  transform.rotation.y = q.y();
+  transform.rotation.z = q.z();
+  return transform;
+}
+
+bool isFinitePose(const geometry_msgs::Pose& pose) {
+  const double values[] = {pose.position.x,    pose.position.y,    pose.position.z,
+                           pose.orientation.w, pose.orientation.x, pose.orientation.y,
+                           pose.orientation.z};
+  for (double v : values) {
+    if (!std::isfinite(v)) return false;
+  }
+  const double norm2 =
+      pose.orientation.w * pose.orientation.w + pose.orientation.x * pose.orientation.x +
+      pose.orientation.y * pose.orientation.y + pose.orientation.z * pose.orientation.z;
+  return norm2 > 0.25 && norm2 < 4.0;
+}
+
+Eigen::Isometry3d interpolatePose(const StampedPose& before, const StampedPose& after,
+                                  double stamp) {
+  const double span = after.stamp - before.stamp;
+  if (!(std::abs(span) > 0.0)) return before.pose;
+  const double s = (stamp - before.stamp) / span;
+  const Eigen::Quaterniond q0(before.pose.linear());
+  const Eigen::Quaterniond q1(after.pose.linear());
+  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
+  result.translation() =
+      before.pose.translation() + s * (after.pose.translation() - before.pose.translation());
+  result.linear() = q0.slerp(s, q1).normalized().toRotationMatrix();
+  return result;
+}
+
+}  // namespace online_stereo_calibration

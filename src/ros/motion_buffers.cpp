@@ -1,0 +1,79 @@
+/// @file motion_buffers.cpp
+/// @brief PoseBuffer and GyroIntegrator.
+#include "online_stereo_calibration/ros/motion_buffers.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace online_stereo_calibration {
+
+std::string lookupStatusName(LookupStatus status) {
+  switch (status) {
+    case LookupStatus::kOk:
+      return "ok";
+    case LookupStatus::kNotYet:
+      return "no motion sample after the image stamp yet";
+    case LookupStatus::kTooOld:
+      return "image stamp older than the motion history";
+    case LookupStatus::kGap:
+      return "gap in the motion samples around the image stamp";
+    case LookupStatus::kEmpty:
+      return "no motion sample received";
+  }
+  return "unknown";
+}
+
+bool PoseBuffer::add(const StampedPose& sample) {
+  if (!std::isfinite(sample.stamp) || !sample.pose.matrix().allFinite()) return false;
+  if (!samples_.empty() && !(sample.stamp > samples_.back().stamp)) return false;
+  samples_.push_back(sample);
+  while (samples_.size() > 2 && samples_.front().stamp < sample.stamp - history_) {
+    samples_.pop_front();
+  }
+  return true;
+}
+
+LookupStatus PoseBuffer::poseAt(double stamp, Eigen::Isometry3d* pose) const {
+  if (samples_.empty()) return LookupStatus::kEmpty;
+  if (stamp > samples_.back().stamp) return LookupStatus::kNotYet;
+  if (stamp < samples_.front().stamp) return LookupStatus::kTooOld;
+  auto after = std::lower_bound(samples_.begin(), samples_.end(), stamp,
+                                [](const StampedPose& s, double t) { return s.stamp < t; });
+  if (after->stamp == stamp) {
+    *pose = after->pose;
+    return LookupStatus::kOk;
+  }
+  auto before = after - 1;
+  if (after->stamp - before->stamp > max_gap_) return LookupStatus::kGap;
+  *pose = interpolatePose(*before, *after, stamp);
+  return LookupStatus::kOk;
+}
+
+bool GyroIntegrator::add(double stamp, const Eigen::Vector3d& angular_rate) {
+  if (!std::isfinite(stamp) || !angular_rate.allFinite()) return false;
+  if (!samples_.empty() && !(stamp > samples_.back().stamp)) return false;
+  samples_.push_back({stamp, angular_rate});
+  while (samples_.size() > 2 && samples_.front().stamp < stamp - history_) samples_.pop_front();
+  return true;
+}
+
+LookupStatus GyroIntegrator::rotationBetween(double from, double to,
+                                             Eigen::Matrix3d* rotation) const {
+  if (samples_.empty()) return LookupStatus::kEmpty;
+  if (to > samples_.back().stamp) return LookupStatus::kNotYet;
+  if (from < samples_.front().stamp) return LookupStatus::kTooOld;
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  for (size_t i = 0; i + 1 < samples_.size(); ++i) {
+    const double t0 = std::max(samples_[i].stamp, from);
+    const double t1 = std::min(samples_[i + 1].stamp, to);
+    if (t1 <= t0) continue;
+    if (samples_[i + 1].stamp - samples_[i].stamp > max_gap_) return LookupStatus::kGap;
+    const Eigen::Vector3d angle = samples_[i].rate * (t1 - t0);
+    const double norm = angle.norm();
+    if (norm > 0.0) q = q * Eigen::Quaterniond(Eigen::AngleAxisd(norm, angle / norm));
+  }
+  *rotation = q.normalized().toRotationMatrix();
+  return LookupStatus::kOk;
+}
+
+}  // namespace online_stereo_calibration

@@ -1,0 +1,107 @@
+/// @file motion_source.cpp
+/// @brief Odometry / tf / IMU -> MotionIncrement.
+#include "online_stereo_calibration/ros/motion_source.h"
+
+#include <tf2/exceptions.h>
+
+#include "online_stereo_calibration/ros/conversions.h"
+
+namespace online_stereo_calibration {
+
+MotionSource::MotionSource(ros::NodeHandle& nh, const RosConfig& config, tf2_ros::Buffer* tf)
+    : config_(config),
+      tf_(tf),
+      poses_(config.motion_history, config.max_motion_gap),
+      gyro_(config.motion_history, config.max_motion_gap) {
+  if (config_.motion_source == MotionSourceType::kOdom) {
+    odom_sub_ = nh.subscribe("odom", 200, &MotionSource::odomCallback, this);
+  }
+  if (config_.use_imu) imu_sub_ = nh.subscribe("imu", 1000, &MotionSource::imuCallback, this);
+}
+
+void MotionSource::odomCallback(const nav_msgs::Odometry::ConstPtr& message) {
+  if (!isFinitePose(message->pose.pose)) {
+    ++rejected_samples;
+    ROS_WARN_THROTTLE(5.0, "online_stereo_calibration: odometry with a non-finite pose ignored");
+    return;
+  }
+  StampedPose sample{message->header.stamp.toSec(), isometryFromPose(message->pose.pose)};
+  bool added = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    added = poses_.add(sample);
+  }
+  if (!added) {
+    ++rejected_samples;
+    ROS_WARN_THROTTLE(5.0,
+                      "online_stereo_calibration: odometry stamp %.9f not newer than the last "
+                      "one, ignored",
+                      sample.stamp);
+    return;
+  }
+  if (on_odom) on_odom();
+}
+
+void MotionSource::imuCallback(const sensor_msgs::Imu::ConstPtr& message) {
+  const Eigen::Vector3d rate(message->angular_velocity.x, message->angular_velocity.y,
+                             message->angular_velocity.z);
+  bool added = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    added = gyro_.add(message->header.stamp.toSec(), rate);
+  }
+  if (!added) {
+    ++rejected_samples;
+    ROS_WARN_THROTTLE(5.0,
+                      "online_stereo_calibration: imu sample non-finite or out of order, ignored");
+    return;
+  }
+  if (on_imu) on_imu();
+}
+
+LookupStatus MotionSource::poseAt(const ros::Time& stamp, Eigen::Isometry3d* pose) {
+  if (config_.motion_source == MotionSourceType::kTf) {
+    try {
+      const geometry_msgs::TransformStamped transform =
+          tf_->lookupTransform(config_.fixed_frame, config_.vehicle_frame, stamp);
+      *pose = isometryFromTransform(transform.transform);
+      return pose->matrix().allFinite() ? LookupStatus::kOk : LookupStatus::kGap;
+    } catch (const tf2::TransformException&) {
+      return LookupStatus::kNotYet;
+    }
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  return poses_.poseAt(stamp.toSec(), pose);
+}
+
+LookupStatus MotionSource::poseAvailable(const ros::Time& stamp) {
+  Eigen::Isometry3d pose;
+  return poseAt(stamp, &pose);
+}
+
+LookupStatus MotionSource::motionBetween(const ros::Time& previous, const ros::Time& current,
+                                         osc::MotionIncrement* motion) {
+  Eigen::Isometry3d pose_previous, pose_current;
+  LookupStatus status = poseAt(current, &pose_current);
+  if (status != LookupStatus::kOk) return status;
+  status = poseAt(previous, &pose_previous);
+  if (status != LookupStatus::kOk) return status;
+  motion->T_prev_curr = pose_previous.inverse() * pose_current;
+  motion->dt = (current - previous).toSec();
+  if (config_.use_imu) {
+    Eigen::Matrix3d rotation;
+    std::lock_guard<std::mutex> lock(mutex_);
+    status = gyro_.rotationBetween(previous.toSec(), current.toSec(), &rotation);
+    if (status != LookupStatus::kOk) return status;
+    motion->T_prev_curr.linear() = rotation;
+  }
+  return LookupStatus::kOk;
+}
+
+void MotionSource::clear() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  poses_.clear();
+  gyro_.clear();
+}
+
+}  // namespace online_stereo_calibration

@@ -1,0 +1,151 @@
+/// @file test_odometry_interpolation.cpp
+/// @brief Pure conversions of the ROS adapter (no master): pose interpolation (linear +
+/// SLERP) against a known trajectory, the pose buffer and gyro integrator, CameraInfo ->
+/// CameraIntrinsics, and the calibration message's transforms vs. its parameters.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "online_stereo_calibration/ros/conversions.h"
+#include "online_stereo_calibration/ros/motion_buffers.h"
+#include "online_stereo_calibration/ros/output_publisher.h"
+
+namespace online_stereo_calibration {
+namespace {
+
+/// A known trajectory: constant velocity along x and constant yaw rate, so that linear
+/// interpolation of the translation along a straight segment and SLERP are exact.
+Eigen::Isometry3d truthAt(double t) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(2.0 * t, -0.5 * t, 0.1 * t);
+  pose.linear() = (Eigen::AngleAxisd(0.3 * t, Eigen::Vector3d::UnitZ()) *
+                   Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()))
+                      .toRotationMatrix();
+  return pose;
+}
+
+void expectPoseNear(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double tolerance) {
+  EXPECT_NEAR((a.translation() - b.translation()).norm(), 0.0, tolerance);
+  EXPECT_NEAR(Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle(), 0.0, tolerance);
+}
+
+TEST(InterpolatePose, ExactOnConstantRateTrajectoryBetweenSamples) {
+  const StampedPose before{10.0, truthAt(10.0)};
+  const StampedPose after{10.1, truthAt(10.1)};
+  for (double s : {0.0, 0.25, 0.5, 0.73, 1.0}) {
+    const double t = 10.0 + 0.1 * s;
+    expectPoseNear(interpolatePose(before, after, t), truthAt(t), 1e-12);
+  }
+}
+
+TEST(InterpolatePose, EqualStampsReturnTheFirst) {
+  const StampedPose a{1.0, truthAt(1.0)};
+  expectPoseNear(interpolatePose(a, a, 1.0), truthAt(1.0), 1e-15);
+}
+
+TEST(PoseBuffer, InterpolatesAtImageStampsAndReportsWhy) {
+  PoseBuffer buffer(10.0, 0.5);
+  Eigen::Isometry3d pose;
+  EXPECT_EQ(buffer.poseAt(1.0, &pose), LookupStatus::kEmpty);
+  for (int i = 0; i <= 20; ++i) EXPECT_TRUE(buffer.add({1.0 + 0.02 * i, truthAt(1.0 + 0.02 * i)}));
+  ASSERT_EQ(buffer.poseAt(1.0333, &pose), LookupStatus::kOk);
+  expectPoseNear(pose, truthAt(1.0333), 1e-12);
+  EXPECT_EQ(buffer.poseAt(1.5, &pose), LookupStatus::kNotYet);
+  EXPECT_EQ(buffer.poseAt(0.5, &pose), LookupStatus::kTooOld);
+  // Duplicated and out-of-order stamps are refused.
+  EXPECT_FALSE(buffer.add({1.4, truthAt(1.4)}));
+  EXPECT_FALSE(buffer.add({1.2, truthAt(1.2)}));
+  // A NaN pose is refused.
+  Eigen::Isometry3d nan_pose = truthAt(2.0);
+  nan_pose.translation().x() = std::nan("");
+  EXPECT_FALSE(buffer.add({2.0, nan_pose}));
+  // A gap larger than max_gap is reported, not bridged.
+  EXPECT_TRUE(buffer.add({3.0, truthAt(3.0)}));
+  EXPECT_EQ(buffer.poseAt(2.0, &pose), LookupStatus::kGap);
+}
+
+TEST(GyroIntegrator, IntegratesConstantRate) {
+  GyroIntegrator gyro(10.0, 0.5);
+  const Eigen::Vector3d rate(0.0, 0.0, 0.3);
+  for (int i = 0; i <= 100; ++i) EXPECT_TRUE(gyro.add(0.01 * i, rate));
+  Eigen::Matrix3d rotation;
+  ASSERT_EQ(gyro.rotationBetween(0.105, 0.555, &rotation), LookupStatus::kOk);
+  const Eigen::Matrix3d expected =
+      Eigen::AngleAxisd(0.3 * 0.45, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  EXPECT_NEAR((rotation - expected).norm(), 0.0, 1e-12);
+  EXPECT_EQ(gyro.rotationBetween(0.5, 1.5, &rotation), LookupStatus::kNotYet);
+}
+
+TEST(CameraInfo, ConvertsKDAndModel) {
+  sensor_msgs::CameraInfo info;
+  info.width = 1280;
+  info.height = 720;
+  info.K = {700.0, 0.0, 640.5, 0.0, 701.0, 360.25, 0.0, 0.0, 1.0};
+  info.distortion_model = "plumb_bob";
+  info.D = {-0.1, 0.01, 0.001, -0.002, 0.0};
+  const osc::CameraIntrinsics intrinsics = intrinsicsFromCameraInfo(info);
+  EXPECT_EQ(intrinsics.width, 1280);
+  EXPECT_EQ(intrinsics.height, 720);
+  EXPECT_DOUBLE_EQ(intrinsics.fx, 700.0);
+  EXPECT_DOUBLE_EQ(intrinsics.fy, 701.0);
+  EXPECT_DOUBLE_EQ(intrinsics.cx, 640.5);
+  EXPECT_DOUBLE_EQ(intrinsics.cy, 360.25);
+  EXPECT_EQ(intrinsics.model, osc::DistortionModel::kPlumbBob);
+  EXPECT_EQ(intrinsics.distortion, info.D);
+
+  info.distortion_model = "equidistant";
+  info.D = {0.1, 0.01, 0.0, 0.0};
+  EXPECT_EQ(intrinsicsFromCameraInfo(info).model, osc::DistortionModel::kEquidistant);
+
+  info.distortion_model = "no_such_model";
+  EXPECT_THROW(intrinsicsFromCameraInfo(info), std::invalid_argument);
+  // Uncalibrated camera (K all zero), as image_proc rejects it.
+  sensor_msgs::CameraInfo uncalibrated;
+  uncalibrated.width = 640;
+  uncalibrated.height = 480;
+  EXPECT_THROW(intrinsicsFromCameraInfo(uncalibrated), std::invalid_argument);
+}
+
+TEST(CalibrationMessage, TransformsEqualParametersUnderInterfaceConventions) {
+  osc::CalibrationEstimate estimate;
+  estimate.parameters << 1.5, 0.2, 1.3, 0.01, -0.02, 0.03, 0.001, -0.12, 0.002, 0.004, -0.003,
+      0.002;
+  estimate.extrinsics = osc::StereoExtrinsics::fromParameters(estimate.parameters);
+  estimate.parameter_covariance = osc::Matrix12d::Identity() * 1e-4;
+  const OutputFrames frames{"base_link", "left_optical", "right_optical"};
+  const StereoCalibration message =
+      makeCalibrationMessage(estimate, ros::Time(12.5), frames, 1, 0.01);
+  EXPECT_EQ(message.header.frame_id, "base_link");
+  EXPECT_EQ(message.left_frame_id, "left_optical");
+  EXPECT_DOUBLE_EQ(message.header.stamp.toSec(), 12.5);
+  // vehicle -> left optical = pose(vehicle_to_left) * R_body_optical.
+  const Eigen::Isometry3d T_veh_caml = osc::poseFromParameters(estimate.parameters.head<6>());
+  const Eigen::Isometry3d T_caml_camr = osc::poseFromParameters(estimate.parameters.tail<6>());
+  const Eigen::Isometry3d B = osc::bodyFromOptical();
+  expectPoseNear(isometryFromTransform(message.vehicle_to_left), T_veh_caml * B, 1e-12);
+  expectPoseNear(isometryFromTransform(message.left_to_right), B.inverse() * T_caml_camr * B,
+                 1e-12);
+  for (int i = 0; i < 12; ++i) {
+    EXPECT_DOUBLE_EQ(message.parameters[i], estimate.parameters(i));
+    EXPECT_NEAR(message.sigma[i], 1e-2, 1e-15);
+  }
+  // Baseline of -0.12 m along the left body y axis = +0.12 m along the left optical x axis.
+  EXPECT_NEAR(message.left_to_right.translation.x, 0.12, 0.01);
+}
+
+TEST(CalibrationState, FollowsPointsAndThresholds) {
+  osc::CalibrationEstimate estimate;
+  estimate.tracked_points = 50;
+  estimate.parameter_covariance = osc::Matrix12d::Identity() * 1e-8;
+  EXPECT_EQ(calibrationState(estimate, false, 10, 0.01, 0.01), StereoCalibration::STATE_CONVERGED);
+  EXPECT_EQ(calibrationState(estimate, true, 10, 0.01, 0.01), StereoCalibration::STATE_DIVERGED);
+  estimate.tracked_points = 3;
+  EXPECT_EQ(calibrationState(estimate, false, 10, 0.01, 0.01),
+            StereoCalibration::STATE_INITIALIZING);
+  estimate.tracked_points = 50;
+  estimate.parameter_covariance(9, 9) = 1.0;
+  EXPECT_EQ(calibrationState(estimate, false, 10, 0.01, 0.01), StereoCalibration::STATE_CONVERGING);
+}
+
+}  // namespace
+}  // namespace online_stereo_calibration
