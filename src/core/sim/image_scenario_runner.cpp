@@ -100,21 +100,7 @@ std::vector<ImageFrameResult> runImageScenario(
     }
     for (PointId id : result.estimator.dropped) birth_points.erase(id);
 
-    const CalibrationEstimate& estimate = result.estimate;
-    ScenarioFrameResult& f = r.filter;
-    f.frame = frame.index;
-    f.stamp = frame.stamp;
-    f.parameters = estimate.parameters;
-    f.sigmas = estimate.sigmas();
-    f.truth = frame.truth.toParameters();
-    f.tangent_error.head<6>() = boxMinus(frame.truth.T_veh_caml, estimate.extrinsics.T_veh_caml);
-    f.tangent_error.tail<6>() = boxMinus(frame.truth.T_caml_camr, estimate.extrinsics.T_caml_camr);
-    f.tangent_sigmas = estimate.tangent_covariance.diagonal().cwiseSqrt();
-    f.nees = f.tangent_error.dot(estimate.tangent_covariance.ldlt().solve(f.tangent_error));
-    f.tracked_points = static_cast<int>(estimate.tracked_points);
-    f.new_points = result.estimator.new_points;
-    f.jump_detected = result.estimator.step.jump != JumpBlock::kNone;
-    f.time_ms = 1e3 * result.processing_time;
+    r.filter = makeFrameResult(frame, result.estimate, result.estimator, 1e3 * result.processing_time);
     if (on_frame) on_frame(r, pipeline);
     results.push_back(r);
   }

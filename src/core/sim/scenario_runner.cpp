@@ -8,6 +8,25 @@
 
 namespace osc {
 
+ScenarioFrameResult makeFrameResult(const SimulatedFrame& frame, const CalibrationEstimate& estimate,
+                                    const FrameReport& report, double time_ms) {
+  ScenarioFrameResult r;
+  r.frame = frame.index;
+  r.stamp = frame.stamp;
+  r.parameters = estimate.parameters;
+  r.sigmas = estimate.sigmas();
+  r.truth = frame.truth.toParameters();
+  r.tangent_error.head<6>() = boxMinus(frame.truth.T_veh_caml, estimate.extrinsics.T_veh_caml);
+  r.tangent_error.tail<6>() = boxMinus(frame.truth.T_caml_camr, estimate.extrinsics.T_caml_camr);
+  r.tangent_sigmas = estimate.tangent_covariance.diagonal().cwiseSqrt();
+  r.nees = r.tangent_error.dot(estimate.tangent_covariance.ldlt().solve(r.tangent_error));
+  r.tracked_points = static_cast<int>(estimate.tracked_points);
+  r.new_points = report.new_points;
+  r.jump_detected = report.step.jump != JumpBlock::kNone;
+  r.time_ms = time_ms;
+  return r;
+}
+
 std::vector<ScenarioFrameResult> runMeasurementScenario(
     const MeasurementScenario& scenario, const FilterConfig& config,
     const std::function<void(const ScenarioFrameResult&)>& on_frame) {
@@ -23,20 +42,8 @@ std::vector<ScenarioFrameResult> runMeasurementScenario(
     const auto stop = std::chrono::steady_clock::now();
     simulator.dropTracks(report.dropped);
 
-    ScenarioFrameResult r;
-    r.frame = frame.index;
-    r.stamp = frame.stamp;
-    r.parameters = estimate.parameters;
-    r.sigmas = estimate.sigmas();
-    r.truth = frame.truth.toParameters();
-    r.tangent_error.head<6>() = boxMinus(frame.truth.T_veh_caml, estimate.extrinsics.T_veh_caml);
-    r.tangent_error.tail<6>() = boxMinus(frame.truth.T_caml_camr, estimate.extrinsics.T_caml_camr);
-    r.tangent_sigmas = estimate.tangent_covariance.diagonal().cwiseSqrt();
-    r.nees = r.tangent_error.dot(estimate.tangent_covariance.ldlt().solve(r.tangent_error));
-    r.tracked_points = static_cast<int>(estimate.tracked_points);
-    r.new_points = report.new_points;
-    r.jump_detected = report.step.jump != JumpBlock::kNone;
-    r.time_ms = std::chrono::duration<double, std::milli>(stop - start).count();
+    const ScenarioFrameResult r = makeFrameResult(
+        frame, estimate, report, std::chrono::duration<double, std::milli>(stop - start).count());
     if (on_frame) on_frame(r);
     results.push_back(r);
   }

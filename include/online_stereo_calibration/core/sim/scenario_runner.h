@@ -9,6 +9,7 @@
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
 #include "online_stereo_calibration/core/sim/measurement_scenario.h"
+#include "online_stereo_calibration/core/sim/measurement_simulator.h"
 
 namespace osc {
 
@@ -29,6 +30,10 @@ struct ScenarioFrameResult {
   bool jump_detected = false;
   double time_ms = 0.0;  ///< estimator time for this frame
 };
+
+/// One frame's result from the estimate after it, the truth and the estimator's report.
+ScenarioFrameResult makeFrameResult(const SimulatedFrame& frame, const CalibrationEstimate& estimate,
+                                    const FrameReport& report, double time_ms);
 
 /// Runs scenario through a StereoCalibrationEstimator starting from the scenario's initial
 /// guess; calls on_frame after each frame if given.
