@@ -16,6 +16,7 @@
 #include <string>
 #include <sys/stat.h>
 
+#include "online_stereo_calibration/tools/output_directory.h"
 #include "online_stereo_calibration/core/sim/scenario_runner.h"
 #include "online_stereo_calibration/tools/calibration_file.h"
 #include "online_stereo_calibration/tools/estimates_csv.h"
@@ -72,19 +73,6 @@ osc::MeasurementScenario scenarioByName(const std::string& name) {
   throw std::invalid_argument("unknown scenario '" + name + "' (paper_offroad, urban_planar, drift)");
 }
 
-void makeDirectories(const std::string& path) {
-  std::string partial;
-  for (size_t i = 0; i <= path.size(); ++i) {
-    if (i == path.size() || path[i] == '/') {
-      if (!partial.empty()) mkdir(partial.c_str(), 0755);
-    }
-    if (i < path.size()) partial += path[i];
-  }
-  struct stat st;
-  if (stat(path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
-    throw std::runtime_error("cannot create output directory '" + path + "'");
-  }
-}
 
 }  // namespace
 
@@ -96,7 +84,7 @@ int main(int argc, char** argv) {
     if (options.seed >= 0) scenario.seed = static_cast<unsigned>(options.seed);
     const osc::FilterConfig config =
         options.config.empty() ? osc::FilterConfig() : osc::readFilterConfigFile(options.config);
-    makeDirectories(options.out);
+    osc::makeDirectories(options.out);
 
     osc::EstimatesCsvWriter estimates(options.out + "/estimates.csv");
     osc::ReferenceCsvWriter reference(options.out + "/reference.csv");

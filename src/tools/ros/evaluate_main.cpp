@@ -29,6 +29,7 @@
 #include <sensor_msgs/Image.h>
 
 #include "bag_io.h"
+#include "online_stereo_calibration/tools/output_directory.h"
 #include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
 #include "online_stereo_calibration/tools/bag_evaluation.h"
 #include "online_stereo_calibration/tools/calibration_file.h"
@@ -97,17 +98,6 @@ bool isFile(const std::string& path) {
   return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
-void makeDirectories(const std::string& path) {
-  std::string partial;
-  for (size_t i = 0; i <= path.size(); ++i) {
-    if ((i == path.size() || path[i] == '/') && !partial.empty()) mkdir(partial.c_str(), 0755);
-    if (i < path.size()) partial += path[i];
-  }
-  struct stat st;
-  if (stat(path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
-    throw std::runtime_error("cannot create output directory '" + path + "'");
-  }
-}
 
 std::string directoryOf(const std::string& path) {
   const auto slash = path.find_last_of('/');
@@ -167,7 +157,7 @@ int main(int argc, char** argv) {
     const osc::CalibrationFile guess = osc::readCalibrationFile(guess_path);
     const osc::FilterConfig config =
         options.config.empty() ? osc::FilterConfig() : osc::readFilterConfigFile(options.config);
-    makeDirectories(options.out);
+    osc::makeDirectories(options.out);
 
     rosbag::Bag bag(options.bag, rosbag::bagmode::Read);
     const osc::CameraIntrinsics left_camera = readCameraInfo(bag, topics.left_info);

@@ -20,6 +20,7 @@
 #include <rosbag/bag.h>
 
 #include "bag_io.h"
+#include "online_stereo_calibration/tools/output_directory.h"
 #include "online_stereo_calibration/tools/bag_evaluation.h"
 #include "online_stereo_calibration/tools/calibration_file.h"
 #include "online_stereo_calibration/tools/drive_simulation.h"
@@ -66,17 +67,6 @@ bool exists(const std::string& path) {
   return stat(path.c_str(), &st) == 0;
 }
 
-void makeDirectories(const std::string& path) {
-  std::string partial;
-  for (size_t i = 0; i <= path.size(); ++i) {
-    if ((i == path.size() || path[i] == '/') && !partial.empty()) mkdir(partial.c_str(), 0755);
-    if (i < path.size()) partial += path[i];
-  }
-  struct stat st;
-  if (stat(path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
-    throw std::runtime_error("cannot create output directory '" + path + "'");
-  }
-}
 
 void writeCalibration(const std::string& path, const osc::Vector12d& parameters, double stamp) {
   osc::CalibrationFile file;
@@ -103,7 +93,7 @@ int main(int argc, char** argv) {
                 << fingerprint << "), nothing to do\n";
       return 0;
     }
-    makeDirectories(options.out);
+    osc::makeDirectories(options.out);
     const osc::MeasurementScenario& m = scenario.measurement;
     std::cerr << "simulating drive '" << m.name << "': " << frames << " frames at " << m.rate_hz
               << " Hz, " << m.left.width << "x" << m.left.height << ", odometry at "
