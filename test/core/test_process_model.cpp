@@ -6,6 +6,7 @@
 
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
+#include "online_stereo_calibration/core/filter/motion_excitation.h"
 #include "online_stereo_calibration/core/filter/process_model.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
 
@@ -27,6 +28,73 @@ TEST(ProcessModel, PredictPointKeepsTheWorldPointFixed) {
   const Eigen::Vector3d p0(1.0, -0.5, 12.0);
   const Eigen::Vector3d p1 = predictPoint(p0, T_veh_lopt, T_w_v0.inverse() * T_w_v1);
   EXPECT_LT((T_w_v0 * T_veh_lopt * p0 - T_w_v1 * T_veh_lopt * p1).norm(), 1e-12);
+}
+
+TEST(ProcessModel, CameraPositionErrorActsThroughTheExcitedRotation) {
+  Vector6d cal;
+  cal << 1.5, 0.2, 1.3, 0.05, -0.1, 0.2;
+  const Eigen::Isometry3d T_veh_lopt = poseFromParameters(cal) * bodyFromOptical();
+  Vector6d m;
+  m << 0.4, 0.1, 0.01, 0.02, -0.03, 0.05;
+  const Eigen::Isometry3d motion = poseFromParameters(m);
+  const Eigen::Vector3d p(1.0, -0.5, 12.0), dt(0.03, -0.02, 0.05);
+  Eigen::Isometry3d shifted = T_veh_lopt;
+  shifted.translation() += dt;
+  // With the measured rotation as the excited one: the plain eq. 7-8.
+  EXPECT_LT(
+      (predictPoint(p, shifted, motion, dt, motion.linear()) - predictPoint(p, shifted, motion))
+          .norm(),
+      1e-12);
+  // With no excited rotation a camera-position error changes nothing (eq. 8: it enters
+  // only through R_motion^T - I).
+  EXPECT_LT((predictPoint(p, shifted, motion, dt, Eigen::Matrix3d::Identity()) -
+             predictPoint(p, T_veh_lopt, motion))
+                .norm(),
+            1e-12);
+  // In between: exactly the lever-arm term of the excited rotation, by hand.
+  const Eigen::Matrix3d R_half = expSO3(0.5 * logSO3(motion.linear()));
+  const Eigen::Vector3d expected =
+      predictPoint(p, T_veh_lopt, motion) +
+      T_veh_lopt.linear().transpose() * (R_half.transpose() - Eigen::Matrix3d::Identity()) * dt;
+  EXPECT_LT((predictPoint(p, shifted, motion, dt, R_half) - expected).norm(), 1e-12);
+}
+
+// Rotation indistinguishable from the motion sensor's noise is not excitation; strong
+// rotation is used as measured (motion_excitation.h).
+TEST(MotionExcitation, NoiseIsNotExcitationButRealRotationIs) {
+  FilterConfig config;  // sigma 0.02 deg per 0.1 s, window 5 s
+  MotionExcitation excitation(config);
+  std::srand(7);
+  const auto gaussian = [] {
+    double u = (std::rand() + 1.0) / (RAND_MAX + 2.0), v = (std::rand() + 1.0) / (RAND_MAX + 2.0);
+    return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * M_PI * v);
+  };
+  const double sigma = config.motion_rotation_noise;
+  for (int k = 0; k < 300; ++k) {
+    // Flat road: roll and pitch are sensor noise only; yaw is a steady 5 deg/s turn.
+    const Eigen::Vector3d rotation(sigma * gaussian(), sigma * gaussian(),
+                                   0.5 * kDeg + sigma * gaussian());
+    excitation.update(expSO3(rotation), 0.1);
+  }
+  const Eigen::Vector3d gains = excitation.gains();
+  EXPECT_LT(gains(0), 0.5);
+  EXPECT_LT(gains(1), 0.5);
+  EXPECT_GT(gains(2), 0.99);
+  // The excited rotation keeps the yaw and drops (most of) the noise roll.
+  const Eigen::Vector3d measured(2.0 * sigma, 0.0, 0.5 * kDeg);
+  const Eigen::Vector3d excited = logSO3(excitation.excitedRotation(expSO3(measured)));
+  EXPECT_LT(std::abs(excited(0)), sigma);
+  EXPECT_NEAR(excited(2), 0.5 * kDeg, 0.01 * kDeg);
+  // Off-road: roll of a few degrees per second is excitation.
+  for (int k = 0; k < 300; ++k) {
+    excitation.update(expSO3(Eigen::Vector3d(0.5 * kDeg * std::sin(0.2 * k), 0.0, 0.0)), 0.1);
+  }
+  EXPECT_GT(excitation.gains()(0), 0.98);
+  // Disabled (the paper): everything is used as measured.
+  config.motion_excitation_window = 0.0;
+  const MotionExcitation off(config);
+  EXPECT_EQ(off.gains(), Eigen::Vector3d::Ones());
+  EXPECT_LT((off.excitedRotation(expSO3(measured)) - expSO3(measured)).norm(), 1e-15);
 }
 
 TEST(ProcessModel, PaperPointNoiseMatchesHandComputation) {
@@ -64,7 +132,7 @@ TEST(ProcessModel, CalibrationDriftIsTheSeedsValuesPerStep) {
 TEST(FilterConfig, DefaultsAndPaperValuesAreValid) {
   EXPECT_TRUE(FilterConfig().validate().empty());
   EXPECT_TRUE(paperFilterConfig().validate().empty());
-  EXPECT_DOUBLE_EQ(paperFilterConfig().point_position_noise, 0.2);  // eq. 14
+  EXPECT_DOUBLE_EQ(paperFilterConfig().point_position_noise, 0.2);             // eq. 14
   EXPECT_NEAR(paperFilterConfig().motion_rotation_noise, 0.02 * kDeg, 1e-15);  // eq. 15
 }
 

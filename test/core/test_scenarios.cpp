@@ -101,18 +101,18 @@ TEST(Observability, CameraHeightNeedsRollOrPitch) {
   const double initial_sigma = FilterConfig().initial_caml_translation_sigma;
   const ScenarioFrameResult p = lastFrame(planar, 300);
   const ScenarioFrameResult r = lastFrame(rolling, 300);
-  // zl: learned with roll/pitch, not without. (Without, the sigma still drops to ~half:
-  // the filter linearises at the *measured* motion, whose 0.02 deg roll/pitch noise looks
-  // like excitation. Iterating the step at the corrected motion would remove that.)
+  // zl: learned with roll/pitch, not from the roll/pitch noise of the measured motion on a
+  // flat road (motion_excitation.h). The drift noise may let it grow a little.
   EXPECT_LT(r.sigmas(2), 0.1 * initial_sigma);
-  EXPECT_GT(p.sigmas(2), 0.3 * initial_sigma);
-  EXPECT_GT(p.sigmas(2), 10.0 * r.sigmas(2));
-  // Re-linearising each step at the corrected motion fakes less information.
-  FilterConfig relinearized;
-  relinearized.motion_relinearizations = 1;
-  EXPECT_GT(lastFrame(planar, 300, relinearized).sigmas(2), 1.2 * p.sigmas(2));
-  EXPECT_LT(p.sigmas(0), 0.2 * initial_sigma);   // xl is learned either way
-  EXPECT_LT(std::abs(p.parameters(2) - p.truth(2)), 3.0 * p.sigmas(2));  // and honest
+  EXPECT_GT(p.sigmas(2), 0.97 * initial_sigma);
+  EXPECT_LT(p.sigmas(2), 1.1 * initial_sigma);
+  EXPECT_LT(std::abs(p.parameters(2) - p.truth(2)), p.sigmas(2));  // and nothing faked
+  EXPECT_LT(p.sigmas(0), 0.2 * initial_sigma);                     // xl is learned either way (yaw)
+  // Linearised at the measured motion (the paper, excitation window 0) the noise is taken
+  // for excitation and zl's sigma shrinks: the case this guards against.
+  FilterConfig measured_linearisation;
+  measured_linearisation.motion_excitation_window = 0.0;
+  EXPECT_LT(lastFrame(planar, 300, measured_linearisation).sigmas(2), 0.7 * initial_sigma);
 }
 
 // Gross outliers (wrong matches) must not drag the calibration.

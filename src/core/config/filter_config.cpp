@@ -71,6 +71,9 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "error of the measured vehicle translation per axis per step (shared model)"),
       integer("motion_relinearizations", &C::motion_relinearizations, 0, 5,
               "shared model: repeat the step linearised at the corrected motion (0 = off)"),
+      real("motion_excitation_window_s", &C::motion_excitation_window, 1.0, 0.0, 1e4,
+           "window of the measured rotation's mean square; rotation within the motion noise is "
+           "not excitation of the camera position (0 = off, as the paper)"),
       real("pixel_noise_px", &C::pixel_noise, 1.0, 1e-3, 100.0,
            "default standard deviation of a feature position"),
       real("outlier_gate", &C::outlier_gate, 1.0, 1.0, 1e6,
@@ -142,6 +145,7 @@ FilterConfig paperFilterConfig() {
   config.point_position_noise = 0.2;  // eq. 14
   config.motion_noise_model = MotionNoiseModel::kPerPoint;
   config.motion_translation_noise = 0.0;  // "not considered in this paper"
+  config.motion_excitation_window = 0.0;  // the paper linearises at the measured motion
   return config;
 }
 

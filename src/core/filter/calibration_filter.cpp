@@ -88,7 +88,7 @@ struct CalibrationFilter::PointInnovation {
 };
 
 CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoIntrinsics& intrinsics)
-    : config_(config), intrinsics_(intrinsics) {
+    : config_(config), excitation_(config), intrinsics_(intrinsics) {
   const std::vector<std::string> problems = config.validate();
   if (!problems.empty()) {
     std::string message = "invalid filter configuration:";
@@ -115,6 +115,7 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& co
   }
   extrinsics_ = guess;
   covariance_ = covariance;
+  excitation_.reset();
   points_.clear();
   index_.clear();
 }
@@ -167,6 +168,7 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
   const double sigma_p2 = config_.point_position_noise * config_.point_position_noise *
                           noiseScale(config_, motion.dt);
   const double sigma_imu = config_.motion_rotation_noise * std::sqrt(noiseScale(config_, motion.dt));
+  const Eigen::Matrix3d R_excited = excitation_.excitedRotation(motion.T_prev_curr.linear());
 
   for (size_t i = 0; i < points_.size(); ++i) {
     TrackedPoint& point = points_[i];
@@ -176,7 +178,7 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
           boxPlus(extrinsics_.T_veh_caml, x.head<6>()) * bodyFromOptical();
       const Eigen::Isometry3d T_prev_curr =
           shared ? boxPlus(motion.T_prev_curr, x.segment<6>(6)) : motion.T_prev_curr;
-      *y = predictPoint(mean + x.tail<3>(), T_veh_lopt, T_prev_curr);
+      *y = predictPoint(mean + x.tail<3>(), T_veh_lopt, T_prev_curr, x.head<3>(), R_excited);
       return true;
     };
     UnscentedResult ut;
@@ -202,6 +204,7 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
   StepReport report;
   report.message = checkMotion(motion);
   if (!report.message.empty()) return report;  // untouched
+  excitation_.update(motion.T_prev_curr.linear(), motion.dt);
 
   // The prediction is linearised at the measured motion. With the shared motion-noise model
   // the step's motion error is estimated with the calibration; the step is then repeated,
@@ -416,6 +419,7 @@ std::vector<PredictedObservation> CalibrationFilter::predictObservations(
   std::vector<PredictedObservation> predictions;
   if (!checkMotion(motion).empty()) return predictions;
   CalibrationFilter scratch = *this;  // the prediction must not touch this filter
+  scratch.excitation_.update(motion.T_prev_curr.linear(), motion.dt);
   std::vector<bool> failed;
   const MatrixXd P = scratch.predict(motion, &failed);
   const double v = config_.pixel_noise * config_.pixel_noise;

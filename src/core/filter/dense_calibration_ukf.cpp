@@ -15,7 +15,7 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 DenseCalibrationUkf::DenseCalibrationUkf(const FilterConfig& config, const StereoIntrinsics& intrinsics)
-    : config_(config), intrinsics_(intrinsics) {
+    : config_(config), excitation_(config), intrinsics_(intrinsics) {
   ut_.alpha = config.ut_alpha;
   ut_.beta = config.ut_beta;
   ut_.kappa = config.ut_kappa;
@@ -27,6 +27,7 @@ void DenseCalibrationUkf::reset(const StereoExtrinsics& guess, const Matrix12d& 
   covariance_ = covariance;
   means_.clear();
   ids_.clear();
+  excitation_.reset();
 }
 
 bool DenseCalibrationUkf::addPoint(const PointMeasurement& measurement) {
@@ -57,6 +58,8 @@ bool DenseCalibrationUkf::step(const MotionIncrement& motion,
   const int n = 12 + 3 * N;
   const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
   const int noise_dim = shared ? 6 : 0;
+  excitation_.update(motion.T_prev_curr.linear(), motion.dt);
+  const Eigen::Matrix3d R_excited = excitation_.excitedRotation(motion.T_prev_curr.linear());
 
   // ---- prediction: sigma points of [state, motion error] through eq. 7-8 ----
   MatrixXd Pa = MatrixXd::Zero(n + noise_dim, n + noise_dim);
@@ -73,7 +76,8 @@ bool DenseCalibrationUkf::step(const MotionIncrement& motion,
         shared ? boxPlus(motion.T_prev_curr, x.tail<6>()) : motion.T_prev_curr;
     for (int i = 0; i < N; ++i) {
       y->segment<3>(12 + 3 * i) =
-          predictPoint(means[i] + x.segment<3>(12 + 3 * i), T_veh_lopt, T_prev_curr);
+          predictPoint(means[i] + x.segment<3>(12 + 3 * i), T_veh_lopt, T_prev_curr,
+                       x.segment<3>(layout::kCaml + layout::kTranslation), R_excited);
     }
     return true;
   };

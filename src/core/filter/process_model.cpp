@@ -8,9 +8,20 @@ namespace osc {
 
 Eigen::Vector3d predictPoint(const Eigen::Vector3d& point_lopt, const Eigen::Isometry3d& T_veh_lopt,
                              const Eigen::Isometry3d& T_prev_curr) {
-  const Eigen::Vector3d in_vehicle_prev = T_veh_lopt * point_lopt;                   // eq. 8, H^veh_caml
-  const Eigen::Vector3d in_vehicle_curr = T_prev_curr.inverse() * in_vehicle_prev;  // H^veh_veh(k+1|k)
-  return T_veh_lopt.inverse() * in_vehicle_curr;                                      // H^caml_veh
+  const Eigen::Vector3d in_vehicle_prev = T_veh_lopt * point_lopt;  // eq. 8, H^veh_caml
+  const Eigen::Vector3d in_vehicle_curr =
+      T_prev_curr.inverse() * in_vehicle_prev;    // H^veh_veh(k+1|k)
+  return T_veh_lopt.inverse() * in_vehicle_curr;  // H^caml_veh
+}
+
+Eigen::Vector3d predictPoint(const Eigen::Vector3d& point_lopt, const Eigen::Isometry3d& T_veh_lopt,
+                             const Eigen::Isometry3d& T_prev_curr,
+                             const Eigen::Vector3d& position_error,
+                             const Eigen::Matrix3d& R_excited) {
+  // d p_k / d t_l = R_lopt^T (R_motion^T - I): swap R_motion for R_excited in that term only.
+  const Eigen::Matrix3d lever_change = R_excited.transpose() - T_prev_curr.linear().transpose();
+  return predictPoint(point_lopt, T_veh_lopt, T_prev_curr) +
+         T_veh_lopt.linear().transpose() * (lever_change * position_error);
 }
 
 double noiseScale(const FilterConfig& config, double dt) { return dt / config.reference_period; }
@@ -46,12 +57,12 @@ Eigen::Matrix3d paperPointProcessNoise(const Eigen::Vector3d& point_lopt, double
   const auto sweep_cos = [sigma_imu](double angle, double radius) {
     return radius * (std::cos(angle + sigma_imu) - std::cos(angle - sigma_imu)) / 2.0;
   };
-  const double phi = std::atan2(z, y), r_yz = std::hypot(y, z);    // roll, eq. 16
-  const double theta = std::atan2(z, x), r_xz = std::hypot(x, z);  // pitch, eq. 17
-  const double psi = std::atan2(y, x), r_xy = std::hypot(x, y);    // yaw, eq. 18
-  const double s_phi_z = sweep_sin(phi, r_yz), s_phi_y = sweep_cos(phi, r_yz);        // eq. 19-20
+  const double phi = std::atan2(z, y), r_yz = std::hypot(y, z);                 // roll, eq. 16
+  const double theta = std::atan2(z, x), r_xz = std::hypot(x, z);               // pitch, eq. 17
+  const double psi = std::atan2(y, x), r_xy = std::hypot(x, y);                 // yaw, eq. 18
+  const double s_phi_z = sweep_sin(phi, r_yz), s_phi_y = sweep_cos(phi, r_yz);  // eq. 19-20
   const double s_theta_z = sweep_sin(theta, r_xz), s_theta_x = sweep_cos(theta, r_xz);  // eq. 21-22
-  const double s_psi_x = sweep_cos(psi, r_xy), s_psi_y = sweep_sin(psi, r_xy);        // eq. 23-24
+  const double s_psi_x = sweep_cos(psi, r_xy), s_psi_y = sweep_sin(psi, r_xy);          // eq. 23-24
   const double sp2 = sigma_p * sigma_p;
   const Eigen::Vector3d q_body(s_theta_x * s_theta_x + s_psi_x * s_psi_x + sp2,   // eq. 25
                                s_phi_y * s_phi_y + s_psi_y * s_psi_y + sp2,       // eq. 26

@@ -45,9 +45,15 @@ struct FilterConfig {
   double motion_rotation_noise = 0.02 * 0.0174532925199432958;  ///< rad per axis per step (eq. 15)
   double motion_translation_noise = 0.002;  ///< m per axis per step (shared model only)
   /// Shared model: repeat each step linearised at the motion corrected by the first pass
-  /// (0 = off). Reduces, but does not remove, the information the motion noise fakes on a
-  /// flat road (zl sigma after 300 frames 0.26 -> 0.37 m of 0.5); doubles the step cost.
+  /// (0 = off). Doubles the step cost. Not needed against the information the motion noise
+  /// fakes on a flat road since motion_excitation_window handles that (zl sigma after 300
+  /// flat frames 0.50 m of 0.50 with or without it; 0.26 m / 0.38 m without the window).
   int motion_relinearizations = 0;
+  /// Window (s) of the running mean square of the measured rotation per vehicle axis; an
+  /// axis rotating no more than motion_rotation_noise is not taken as excitation of the
+  /// camera position (motion_excitation.h). 0 = off (the paper: zl learned from noise on a
+  /// flat road).
+  double motion_excitation_window = 5.0;
 
   // --- measurements, seed eq. 29-30 ---
   double pixel_noise = 0.5;       ///< px, default sigma of a feature position

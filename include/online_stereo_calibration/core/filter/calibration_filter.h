@@ -22,6 +22,7 @@
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/types.h"
 #include "online_stereo_calibration/core/filter/measurement_model.h"
+#include "online_stereo_calibration/core/filter/motion_excitation.h"
 #include "online_stereo_calibration/core/filter/unscented_transform.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 
@@ -139,6 +140,7 @@ class CalibrationFilter {
   void rebuildIndex();
 
   FilterConfig config_;
+  MotionExcitation excitation_;
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;
   StereoExtrinsics extrinsics_;

@@ -12,6 +12,7 @@
 
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
+#include "online_stereo_calibration/core/filter/motion_excitation.h"
 
 namespace osc {
 
@@ -36,6 +37,7 @@ class DenseCalibrationUkf {
 
  private:
   FilterConfig config_;
+  MotionExcitation excitation_;
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;
   StereoExtrinsics extrinsics_;

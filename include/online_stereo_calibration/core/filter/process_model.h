@@ -15,6 +15,16 @@ namespace osc {
 Eigen::Vector3d predictPoint(const Eigen::Vector3d& point_lopt, const Eigen::Isometry3d& T_veh_lopt,
                              const Eigen::Isometry3d& T_prev_curr);
 
+/// Eq. 7-8 at a sigma point whose camera position T_veh_lopt carries the error
+/// `position_error` (vehicle frame): the error acts through the excited part R_excited of the
+/// motion rotation (motion_excitation.h) instead of the measured one, i.e.
+/// predictPoint(...) + R_lopt^T (R_excited^T - R_motion^T) position_error. With
+/// R_excited == R_motion this is predictPoint.
+Eigen::Vector3d predictPoint(const Eigen::Vector3d& point_lopt, const Eigen::Isometry3d& T_veh_lopt,
+                             const Eigen::Isometry3d& T_prev_curr,
+                             const Eigen::Vector3d& position_error,
+                             const Eigen::Matrix3d& R_excited);
+
 /// Variance scale of a per-step noise for a step of dt seconds (random walk: dt / T_ref).
 double noiseScale(const FilterConfig& config, double dt);
 
