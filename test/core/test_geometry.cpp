@@ -804,6 +804,48 @@ TEST(CameraModel, DistortAndUndistortAreInverseOnNormalizedCoordinates) {
   }
 }
 
+// A strong barrel polynomial (plumb_bob k1 = -0.28 alone) turns back at r = 1 / sqrt(3 * 0.28)
+// = 1.09, where the distorted radius peaks at 0.727: pixels beyond that radius have no ray,
+// and inside it the ray must be the one on the optical axis' side of the fold.
+TEST(CameraModel, UndistortStaysOnTheUnfoldedBranchAndRejectsUnreachablePixels) {
+  CameraIntrinsics in;
+  in.width = 752;
+  in.height = 480;
+  in.fx = in.fy = 460.0;
+  in.cx = 376.0;
+  in.cy = 240.0;
+  in.model = DistortionModel::kPlumbBob;
+  in.distortion = {-0.28, 0.0, 0.0, 0.0, 0.0};
+  const CameraModel camera(in);
+  const double fold_radius = 1.0 / std::sqrt(3.0 * 0.28);
+  const double peak = fold_radius * (1.0 - 0.28 * fold_radius * fold_radius);
+  const Eigen::Vector2d direction = Eigen::Vector2d(376.0, 240.0).normalized();
+  for (double rd : {0.2, 0.5, 0.7, 0.99 * peak}) {
+    Eigen::Vector2d n;
+    ASSERT_TRUE(camera.undistort(rd * direction, &n)) << rd;
+    EXPECT_LT(n.norm(), fold_radius) << rd;  // the axis-side branch, not the folded one
+    EXPECT_TRUE(matrixNear(camera.distort(n), rd * direction, 1e-9)) << rd;
+  }
+  // The image corner (distorted radius 0.97) is beyond the peak: no ray, nothing written.
+  Eigen::Vector2d untouched(7.0, 7.0);
+  EXPECT_FALSE(camera.pixelToNormalized(Eigen::Vector2d(0.0, 0.0), &untouched));
+  EXPECT_EQ(untouched, Eigen::Vector2d(7.0, 7.0));
+  EXPECT_FALSE(camera.undistort(1.01 * peak * direction, &untouched));
+  // The best-effort form returns its input there instead of a folded ray.
+  EXPECT_EQ(camera.undistort(1.01 * peak * direction), 1.01 * peak * direction);
+  // Non-finite input is rejected, not iterated.
+  EXPECT_FALSE(camera.undistort(Eigen::Vector2d(std::nan(""), 0.0), &untouched));
+  // Equidistant: a distorted angle past 90 deg has no ray in front of the camera.
+  CameraIntrinsics fisheye = in;
+  fisheye.model = DistortionModel::kEquidistant;
+  fisheye.distortion = {0.001, 0.0, 0.0, 0.0};  // (all zero would be a plain pinhole)
+  const CameraModel equidistant(fisheye);
+  EXPECT_TRUE(equidistant.undistort(Eigen::Vector2d(1.2, 0.0), &untouched));
+  EXPECT_GT(untouched.x(), std::tan(1.19));
+  EXPECT_TRUE(matrixNear(equidistant.distort(untouched), Eigen::Vector2d(1.2, 0.0), 1e-9));
+  EXPECT_FALSE(equidistant.undistort(Eigen::Vector2d(1.7, 0.0), &untouched));
+}
+
 TEST(CameraModel, EquidistantDistortionIsTheKannalaBrandtPolynomial) {
   // theta = atan(r), theta_d = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8),
   // distorted = normalized * theta_d / r.

@@ -25,22 +25,27 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
   filter_.reset(initial_guess);
 }
 
-bool StereoCalibrationEstimator::toMeasurement(const StereoObservation& o, PointMeasurement* m) const {
+bool StereoCalibrationEstimator::toMeasurement(const StereoObservation& o,
+                                               PointMeasurement* m) const {
   if (!o.left_pixel.allFinite() || !o.right_pixel.allFinite() || !std::isfinite(o.sigma_left) ||
       !std::isfinite(o.sigma_right)) {
     return false;
   }
   m->id = o.id;
-  m->z.head<2>() = left_.undistortPixel(o.left_pixel);
-  m->z.tail<2>() = right_.undistortPixel(o.right_pixel);
+  Eigen::Vector2d left_undistorted, right_undistorted;
+  if (!left_.undistortPixel(o.left_pixel, &left_undistorted) ||
+      !right_.undistortPixel(o.right_pixel, &right_undistorted)) {
+    return false;  // beyond what the lens model maps to a ray (camera_model.h)
+  }
+  m->z << left_undistorted, right_undistorted;
   const double sl = o.sigma_left > 0.0 ? o.sigma_left : config_.pixel_noise;
   const double sr = o.sigma_right > 0.0 ? o.sigma_right : config_.pixel_noise;
   m->variance << sl * sl, sl * sl, sr * sr, sr * sr;
   return m->z.allFinite();
 }
 
-FrameReport StereoCalibrationEstimator::processFrame(const MotionIncrement& motion,
-                                                     const std::vector<StereoObservation>& observations) {
+FrameReport StereoCalibrationEstimator::processFrame(
+    const MotionIncrement& motion, const std::vector<StereoObservation>& observations) {
   FrameReport report;
   std::vector<PointMeasurement> tracked, candidates;
   for (const StereoObservation& o : observations) {
@@ -52,8 +57,10 @@ FrameReport StereoCalibrationEstimator::processFrame(const MotionIncrement& moti
     (filter_.hasPoint(o.id) ? tracked : candidates).push_back(m);
   }
   if (report.invalid_observations > 0) {
-    report.warnings.push_back(std::to_string(report.invalid_observations) +
-                              " observation(s) with NaN/Inf pixel or sigma ignored");
+    report.warnings.push_back(
+        std::to_string(report.invalid_observations) +
+        " observation(s) ignored: NaN/Inf pixel or sigma, or a pixel no ray of the lens "
+        "model reaches");
   }
 
   if (has_previous_frame_) {
@@ -73,7 +80,8 @@ FrameReport StereoCalibrationEstimator::processFrame(const MotionIncrement& moti
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());
       }
       if (report.step.covariance_repaired) {
-        report.warnings.push_back("calibration covariance was not positive definite and was repaired");
+        report.warnings.push_back(
+            "calibration covariance was not positive definite and was repaired");
       }
     }
   }
@@ -111,7 +119,8 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
   has_previous_frame_ = false;
 }
 
-void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess, const Matrix12d& tangent_covariance) {
+void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
+                                       const Matrix12d& tangent_covariance) {
   filter_.reset(guess, tangent_covariance);
   has_previous_frame_ = false;
 }

@@ -18,10 +18,14 @@ DistortionModel distortionModelFromName(const std::string& name) {
 
 std::string distortionModelName(DistortionModel model) {
   switch (model) {
-    case DistortionModel::kNone: return "none";
-    case DistortionModel::kPlumbBob: return "plumb_bob";
-    case DistortionModel::kRationalPolynomial: return "rational_polynomial";
-    case DistortionModel::kEquidistant: return "equidistant";
+    case DistortionModel::kNone:
+      return "none";
+    case DistortionModel::kPlumbBob:
+      return "plumb_bob";
+    case DistortionModel::kRationalPolynomial:
+      return "rational_polynomial";
+    case DistortionModel::kEquidistant:
+      return "equidistant";
   }
   return "none";
 }
@@ -41,10 +45,18 @@ void checkCoefficientCount(const CameraIntrinsics& in) {
   const size_t n = in.distortion.size();
   bool ok = true;
   switch (in.model) {
-    case DistortionModel::kNone: ok = true; break;
-    case DistortionModel::kPlumbBob: ok = (n == 4 || n == 5); break;
-    case DistortionModel::kRationalPolynomial: ok = (n >= 4 && n <= 8); break;
-    case DistortionModel::kEquidistant: ok = (n == 4); break;
+    case DistortionModel::kNone:
+      ok = true;
+      break;
+    case DistortionModel::kPlumbBob:
+      ok = (n == 4 || n == 5);
+      break;
+    case DistortionModel::kRationalPolynomial:
+      ok = (n >= 4 && n <= 8);
+      break;
+    case DistortionModel::kEquidistant:
+      ok = (n == 4);
+      break;
   }
   if (!ok) {
     throw std::invalid_argument("camera model '" + distortionModelName(in.model) + "' got " +
@@ -62,13 +74,15 @@ CameraModel::CameraModel(const CameraIntrinsics& intrinsics) : intrinsics_(intri
   }
   if (!(intrinsics.fx > 0.0) || !(intrinsics.fy > 0.0) || !std::isfinite(intrinsics.fx) ||
       !std::isfinite(intrinsics.fy)) {
-    throw std::invalid_argument("camera focal lengths fx, fy must be positive and finite (K[0], K[4])");
+    throw std::invalid_argument(
+        "camera focal lengths fx, fy must be positive and finite (K[0], K[4])");
   }
   if (!std::isfinite(intrinsics.cx) || !std::isfinite(intrinsics.cy)) {
     throw std::invalid_argument("camera principal point cx, cy must be finite (K[2], K[5])");
   }
   for (double d : intrinsics.distortion) {
-    if (!std::isfinite(d)) throw std::invalid_argument("camera distortion coefficients (D) must be finite");
+    if (!std::isfinite(d))
+      throw std::invalid_argument("camera distortion coefficients (D) must be finite");
   }
   checkCoefficientCount(intrinsics);
   // An all-zero D is the rectified case: skip the distortion arithmetic entirely.
@@ -98,8 +112,7 @@ Eigen::Vector2d CameraModel::distort(const Eigen::Vector2d& n) const {
       const double r = std::sqrt(x * x + y * y);
       if (r < 1e-12) return n;
       const double theta = std::atan(r), t2 = theta * theta;
-      const double theta_d =
-          theta * (1.0 + t2 * (d[0] + t2 * (d[1] + t2 * (d[2] + t2 * d[3]))));
+      const double theta_d = theta * (1.0 + t2 * (d[0] + t2 * (d[1] + t2 * (d[2] + t2 * d[3]))));
       return n * (theta_d / r);
     }
   }
@@ -107,38 +120,86 @@ Eigen::Vector2d CameraModel::distort(const Eigen::Vector2d& n) const {
 }
 
 Eigen::Vector2d CameraModel::undistort(const Eigen::Vector2d& distorted) const {
-  if (intrinsics_.model == DistortionModel::kNone) return distorted;
+  Eigen::Vector2d n = distorted;  // kept where the model has no valid ray
+  undistort(distorted, &n);
+  return n;
+}
+
+namespace {
+
+/// Central-difference Jacobian of a 2D -> 2D map.
+template <typename Map>
+Eigen::Matrix2d numericalJacobian(const Map& f, const Eigen::Vector2d& x) {
+  const double h = 1e-7;
+  Eigen::Matrix2d jacobian;
+  for (int k = 0; k < 2; ++k) {
+    Eigen::Vector2d dx = Eigen::Vector2d::Zero();
+    dx(k) = h;
+    jacobian.col(k) = (f(x + dx) - f(x - dx)) / (2.0 * h);
+  }
+  return jacobian;
+}
+
+}  // namespace
+
+bool CameraModel::undistort(const Eigen::Vector2d& distorted, Eigen::Vector2d* normalized) const {
+  if (!distorted.allFinite()) return false;
+  if (intrinsics_.model == DistortionModel::kNone) {
+    *normalized = distorted;
+    return true;
+  }
+  const auto model = [this](const Eigen::Vector2d& x) { return distort(x); };
   if (intrinsics_.model == DistortionModel::kEquidistant) {
     // Invert theta_d = theta * (1 + k1 t^2 + ...) by Newton, then x = tan(theta) * dir.
     const auto& d = intrinsics_.distortion;
     const double theta_d = distorted.norm();
-    if (theta_d < 1e-12) return distorted;
+    if (theta_d < 1e-12) {
+      *normalized = distorted;
+      return true;
+    }
     double theta = theta_d;
     for (int i = 0; i < 30; ++i) {
       const double t2 = theta * theta;
-      const double f = theta * (1.0 + t2 * (d[0] + t2 * (d[1] + t2 * (d[2] + t2 * d[3])))) - theta_d;
-      const double df = 1.0 + t2 * (3.0 * d[0] + t2 * (5.0 * d[1] + t2 * (7.0 * d[2] + 9.0 * t2 * d[3])));
+      const double f =
+          theta * (1.0 + t2 * (d[0] + t2 * (d[1] + t2 * (d[2] + t2 * d[3])))) - theta_d;
+      const double df =
+          1.0 + t2 * (3.0 * d[0] + t2 * (5.0 * d[1] + t2 * (7.0 * d[2] + 9.0 * t2 * d[3])));
+      if (!(df > 0.0)) return false;  // past the fold of theta_d(theta)
       const double step = f / df;
       theta -= step;
       if (std::abs(step) < 1e-14) break;
     }
-    return distorted * (std::tan(theta) / theta_d);
+    if (!(theta > 0.0 && theta < M_PI / 2.0)) return false;  // behind the camera: no ray
+    const Eigen::Vector2d n = distorted * (std::tan(theta) / theta_d);
+    if ((distort(n) - distorted).norm() > 1e-9) return false;
+    *normalized = n;
+    return true;
   }
-  // Gauss-Newton on distort(n) = distorted, numerical 2x2 Jacobian; starts at the distorted point.
+  // Gauss-Newton on distort(n) = distorted, from the distorted point, kept on the branch
+  // that contains the optical axis: a step that would cross the fold (Jacobian determinant
+  // <= 0) or not reduce the residual is halved.
   Eigen::Vector2d n = distorted;
-  for (int i = 0; i < 30; ++i) {
-    const Eigen::Vector2d residual = distort(n) - distorted;
-    if (residual.squaredNorm() < 1e-28) break;
-    Eigen::Matrix2d jacobian;
-    const double h = 1e-7;
-    for (int k = 0; k < 2; ++k) {
-      Eigen::Vector2d dn = Eigen::Vector2d::Zero();
-      dn(k) = h;
-      jacobian.col(k) = (distort(n + dn) - distort(n - dn)) / (2.0 * h);
+  Eigen::Vector2d residual = distort(n) - distorted;
+  for (int i = 0; i < 50 && residual.squaredNorm() >= 1e-28; ++i) {
+    const Eigen::Matrix2d jacobian = numericalJacobian(model, n);
+    if (!(jacobian.determinant() > 0.0)) return false;
+    Eigen::Vector2d step = jacobian.inverse() * residual;
+    bool improved = false;
+    for (int halving = 0; halving < 30 && !improved; ++halving, step *= 0.5) {
+      const Eigen::Vector2d candidate = n - step;
+      const Eigen::Vector2d candidate_residual = distort(candidate) - distorted;
+      if (numericalJacobian(model, candidate).determinant() > 0.0 &&
+          candidate_residual.squaredNorm() < residual.squaredNorm()) {
+        n = candidate;
+        residual = candidate_residual;
+        improved = true;
+      }
     }
-    n -= jacobian.inverse() * residual;
+    if (!improved) break;  // stuck at the fold: the pixel is beyond the model's reach
   }
-  return n;
+  if (!(residual.norm() < 1e-9)) return false;
+  *normalized = n;
+  return true;
 }
 
 bool CameraModel::project(const Eigen::Vector3d& p, Eigen::Vector2d* pixel) const {
@@ -149,7 +210,8 @@ bool CameraModel::project(const Eigen::Vector3d& p, Eigen::Vector2d* pixel) cons
 
 Eigen::Vector2d CameraModel::normalizedToPixel(const Eigen::Vector2d& normalized) const {
   const Eigen::Vector2d d = distort(normalized);
-  return Eigen::Vector2d(intrinsics_.fx * d.x() + intrinsics_.cx, intrinsics_.fy * d.y() + intrinsics_.cy);
+  return Eigen::Vector2d(intrinsics_.fx * d.x() + intrinsics_.cx,
+                         intrinsics_.fy * d.y() + intrinsics_.cy);
 }
 
 Eigen::Vector2d CameraModel::pixelToNormalized(const Eigen::Vector2d& pixel) const {
@@ -158,13 +220,30 @@ Eigen::Vector2d CameraModel::pixelToNormalized(const Eigen::Vector2d& pixel) con
   return undistort(d);
 }
 
+bool CameraModel::pixelToNormalized(const Eigen::Vector2d& pixel,
+                                    Eigen::Vector2d* normalized) const {
+  const Eigen::Vector2d d((pixel.x() - intrinsics_.cx) / intrinsics_.fx,
+                          (pixel.y() - intrinsics_.cy) / intrinsics_.fy);
+  return undistort(d, normalized);
+}
+
 Eigen::Vector2d CameraModel::undistortPixel(const Eigen::Vector2d& pixel) const {
   const Eigen::Vector2d n = pixelToNormalized(pixel);
-  return Eigen::Vector2d(intrinsics_.fx * n.x() + intrinsics_.cx, intrinsics_.fy * n.y() + intrinsics_.cy);
+  return Eigen::Vector2d(intrinsics_.fx * n.x() + intrinsics_.cx,
+                         intrinsics_.fy * n.y() + intrinsics_.cy);
+}
+
+bool CameraModel::undistortPixel(const Eigen::Vector2d& pixel, Eigen::Vector2d* undistorted) const {
+  Eigen::Vector2d n;
+  if (!pixelToNormalized(pixel, &n)) return false;
+  *undistorted = Eigen::Vector2d(intrinsics_.fx * n.x() + intrinsics_.cx,
+                                 intrinsics_.fy * n.y() + intrinsics_.cy);
+  return true;
 }
 
 bool CameraModel::isInImage(const Eigen::Vector2d& pixel, double margin) const {
-  return pixel.x() >= margin && pixel.y() >= margin && pixel.x() <= intrinsics_.width - 1 - margin &&
+  return pixel.x() >= margin && pixel.y() >= margin &&
+         pixel.x() <= intrinsics_.width - 1 - margin &&
          pixel.y() <= intrinsics_.height - 1 - margin;
 }
 

@@ -73,11 +73,8 @@ bool inPrincipalDomain(const CameraModel& camera, const Eigen::Vector2d& n) {
 
 /// Normalized coordinates of a raw pixel, or nothing if no ray of the camera reaches it.
 std::optional<Eigen::Vector2d> pixelRay(const CameraModel& camera, const Eigen::Vector2d& pixel) {
-  const Eigen::Vector2d n = camera.pixelToNormalized(pixel);
-  if (!n.allFinite() || (camera.normalizedToPixel(n) - pixel).norm() > 1e-6 ||
-      !inPrincipalDomain(camera, n)) {
-    return std::nullopt;
-  }
+  Eigen::Vector2d n;
+  if (!camera.pixelToNormalized(pixel, &n) || !inPrincipalDomain(camera, n)) return std::nullopt;
   return n;
 }
 

@@ -47,16 +47,27 @@ class CameraModel {
 
   /// Applies the lens distortion to normalized coordinates.
   Eigen::Vector2d distort(const Eigen::Vector2d& normalized) const;
-  /// Inverse of distort (iterative); exact to ~1e-10 inside the image.
+  /// Inverse of distort (iterative); exact to ~1e-10 inside the image. Where the lens model
+  /// has no valid preimage (see the overload below) the input is returned unchanged.
   Eigen::Vector2d undistort(const Eigen::Vector2d& distorted_normalized) const;
+  /// Inverse of distort on the part of the model that maps rays one-to-one (from the
+  /// optical axis up to the first fold, where a strong barrel polynomial turns back, e.g.
+  /// plumb_bob k1 = -0.28 beyond r = 1.09). False, *normalized untouched, where no such
+  /// preimage exists (pixels beyond what the polynomial can reach): such a pixel has no
+  /// valid ray under this model, and any "solution" would be a wrong, folded one.
+  bool undistort(const Eigen::Vector2d& distorted_normalized, Eigen::Vector2d* normalized) const;
 
   /// Optical-frame point -> raw (distorted) pixel. False if the point is not in front
   /// (z <= 1e-6), pixel untouched then.
   bool project(const Eigen::Vector3d& point_optical, Eigen::Vector2d* pixel) const;
   /// Raw pixel -> normalized undistorted coordinates (x/z, y/z).
   Eigen::Vector2d pixelToNormalized(const Eigen::Vector2d& pixel) const;
+  /// As above; false where the lens model has no valid ray for the pixel (undistort).
+  bool pixelToNormalized(const Eigen::Vector2d& pixel, Eigen::Vector2d* normalized) const;
   /// Raw pixel -> undistorted pixel K * normalized (the filter's measurement space).
   Eigen::Vector2d undistortPixel(const Eigen::Vector2d& pixel) const;
+  /// As above; false where the lens model has no valid ray for the pixel (undistort).
+  bool undistortPixel(const Eigen::Vector2d& pixel, Eigen::Vector2d* undistorted) const;
   /// Normalized coordinates -> raw pixel.
   Eigen::Vector2d normalizedToPixel(const Eigen::Vector2d& normalized) const;
 
