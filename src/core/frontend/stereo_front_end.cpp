@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_set>
 
+#include <Eigen/LU>
 #include <opencv2/imgproc.hpp>
 
 #include "online_stereo_calibration/core/frontend/bucketing.h"
+#include "online_stereo_calibration/core/frontend/patch_alignment.h"
 #include "online_stereo_calibration/core/geometry/stereo_geometry.h"
 
 namespace osc {
@@ -40,7 +43,7 @@ StereoFrontEnd::StereoFrontEnd(const FrontEndConfig& config, const FilterConfig&
       left_camera_(left),
       right_camera_(right),
       detector_(config_),
-      matcher_(config_, filter_config.min_point_depth),
+      matcher_(config_, filter_config.min_point_depth, filter_config.max_point_depth),
       tracker_(config_) {}
 
 std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
@@ -49,6 +52,9 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
                                                        const CalibrationFilter& filter,
                                                        FrontEndStatistics* statistics) {
   FrontEndStatistics stats;
+  // The previous left image, kept as a copy (the caller may reuse its buffers).
+  std::swap(previous_left_, current_left_);
+  left_mono.copyTo(current_left_);
   last_left_ = left_mono;
   last_right_ = right_mono;
   last_tracked_.clear();
@@ -67,11 +73,32 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   const Matrix12d& P = filter.covariance();
   matcher_.setGeometry(left_camera_.K(), right_camera_.K(), filter.extrinsics().T_caml_camr,
                        P.bottomRightCorner<6, 6>());
-  const Eigen::Matrix3d& F = matcher_.fundamental();
   auto on_band = [&](int l, int r) {
     const Eigen::Vector2d& ul = left.undistorted[static_cast<size_t>(l)];
     const Eigen::Vector2d& ur = right.undistorted[static_cast<size_t>(r)];
-    return std::abs(epipolarLine(F, ul).dot(ur.homogeneous())) <= matcher_.bandHalfWidth(ul, ur);
+    const EpipolarMatcher::Lines lines = matcher_.lines(ul);
+    return std::abs(lines.nominal.dot(ur.homogeneous())) <= matcher_.bandHalfWidth(lines, ur);
+  };
+  // Sub-pixel right pixel of a pair: the left keypoint's patch aligned into the right image;
+  // false if the alignment is unreliable (edge, occlusion, different content) or leaves the
+  // epipolar band.
+  PatchAlignmentConfig alignment;
+  alignment.half_size = config_.patch_half_size;
+  alignment.max_shift = config_.max_refinement_shift;
+  alignment.min_ncc = config_.min_patch_ncc;
+  alignment.min_eigenvalue = config_.min_patch_eigen_ratio;
+  auto refine = [&](const Eigen::Vector2d& left_raw, const Eigen::Vector2d& left_und,
+                    const Eigen::Vector2d& right_guess, Eigen::Vector2d* right_raw,
+                    Eigen::Vector2d* right_und, double max_shift = 0.0) {
+    PatchAlignmentConfig c = alignment;
+    if (max_shift > 0.0) c.max_shift = max_shift;
+    const PatchAlignment a = alignPatch(left_mono, left_raw, right_mono, right_guess, c);
+    if (!a.ok) return false;
+    *right_raw = a.position;
+    *right_und = right_camera_.undistortPixel(a.position);
+    const EpipolarMatcher::Lines lines = matcher_.lines(left_und);
+    return std::abs(lines.nominal.dot(right_und->homogeneous())) <=
+           matcher_.bandHalfWidth(lines, *right_und, config_.refined_pixel_sigma);
   };
 
   // 1. Tracking (Sec. II-C): windows from the filter's predictions and S.
@@ -81,9 +108,68 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
         tracker_.windows(filter.predictObservations(motion), left_camera_, right_camera_);
     const std::vector<TrackMatch> found =
         tracker_.track(last_windows_, left, right, &left_used, &right_used, on_band);
+    // Sub-pixel: the point's patch in the previous left image is aligned into this one from
+    // the keypoint found (so the track stays on the same surface point instead of following
+    // the detector's pixel-grid jitter), then into the right image.
+    PatchAlignmentConfig temporal = alignment;
+    temporal.max_shift = config_.max_temporal_shift;
     for (const TrackMatch& m : found) {
-      observations.push_back(observation(m.id, left.raw[static_cast<size_t>(m.left)],
-                                         right.raw[static_cast<size_t>(m.right)]));
+      Eigen::Vector2d left_raw = left.raw[static_cast<size_t>(m.left)];
+      Eigen::Vector2d left_und = left.undistorted[static_cast<size_t>(m.left)];
+      Eigen::Vector2d previous;
+      if (!previous_left_.empty() && tracker_.leftPixel(m.id, &previous)) {
+        const PatchAlignment a =
+            alignPatch(previous_left_, previous, left_mono, left_raw, temporal);
+        if (!a.ok) continue;
+        left_raw = a.position;
+        left_und = left_camera_.undistortPixel(left_raw);
+      }
+      Eigen::Vector2d right_raw, right_und;
+      if (!refine(left_raw, left_und, right.raw[static_cast<size_t>(m.right)], &right_raw,
+                  &right_und)) {
+        continue;
+      }
+      tracker_.setLeftPixel(m.id, left_raw);
+      observations.push_back(observation(m.id, left_raw, right_raw));
+    }
+  }
+  // Tracks whose keypoint was not detected again (or not confirmed): the point's patch of
+  // the previous left image is searched directly around its predicted pixel (Lucas-Kanade
+  // from the prediction, Sec. II-C's window and the filter's S as the gate), then in the
+  // right image around the right prediction moved by the left innovation.
+  if (!previous_left_.empty()) {
+    std::unordered_set<PointId> observed;
+    for (const StereoObservation& o : observations) observed.insert(o.id);
+    for (const TrackWindow& w : last_windows_) {
+      if (observed.count(w.id)) continue;
+      Eigen::Vector2d previous;
+      if (!tracker_.leftPixel(w.id, &previous)) continue;
+      PatchAlignmentConfig search = alignment;
+      search.max_shift = w.left_half.maxCoeff();
+      const PatchAlignment a =
+          alignPatch(previous_left_, previous, left_mono, w.left_center, search);
+      if (!a.ok) continue;
+      const Eigen::Vector2d left_raw = a.position;
+      const Eigen::Vector2d left_und = left_camera_.undistortPixel(left_raw);
+      const Eigen::Vector2d el = left_und - w.z.head<2>();
+      const Eigen::Matrix2d S_ll = w.S.topLeftCorner<2, 2>();
+      if (!(S_ll.determinant() > 0.0) ||
+          el.dot(S_ll.inverse() * el) > config_.track_gate_chi2_2dof) {
+        continue;
+      }
+      Eigen::Vector2d right_raw, right_und;
+      if (!refine(left_raw, left_und, w.right_center + (left_raw - w.left_center), &right_raw,
+                  &right_und, w.right_half.maxCoeff())) {
+        continue;
+      }
+      const Eigen::Vector2d er = right_und - w.z.tail<2>();
+      const Eigen::Matrix2d S_rr = w.S.bottomRightCorner<2, 2>();
+      if (!(S_rr.determinant() > 0.0) ||
+          er.dot(S_rr.inverse() * er) > config_.track_gate_chi2_2dof) {
+        continue;
+      }
+      tracker_.setLeftPixel(w.id, left_raw);
+      observations.push_back(observation(w.id, left_raw, right_raw));
     }
   }
   last_tracked_ = observations;
@@ -92,10 +178,9 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
 
   // 2. New points: epipolar-guided matching with the current x_camr (eq. 5-6).
   const std::vector<StereoMatch> matches = matcher_.match(left, right, left_used, right_used);
-  stats.stereo_matches = static_cast<int>(matches.size());
 
   // 3. Reject what cannot make a good point: behind, too close / far, too little parallax,
-  // or where a tracked point already is.
+  // not confirmed by the sub-pixel alignment, or where a tracked point already is.
   const Eigen::Isometry3d T_lopt_ropt = filter.extrinsics().leftToRightOptical();
   const Eigen::Matrix3d Kl_inv = left_camera_.K().inverse(), Kr_inv = right_camera_.K().inverse();
   std::vector<Eigen::Vector2d> tracked_pixels;
@@ -103,26 +188,29 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   SpatialGrid tracked_grid;
   tracked_grid.build(tracked_pixels, left_mono.cols, left_mono.rows, 32.0);
   const double min_parallax = config_.min_parallax_deg * M_PI / 180.0;
-  std::vector<Eigen::Vector2d> positions;
+  auto plausible = [&](const Eigen::Vector2d& ul, const Eigen::Vector2d& ur) {
+    const auto tri =
+        triangulateMidpoint(Kl_inv * Eigen::Vector3d(ul.x(), ul.y(), 1.0),
+                            Kr_inv * Eigen::Vector3d(ur.x(), ur.y(), 1.0), T_lopt_ropt);
+    if (!tri) return false;
+    const double depth = tri->point_left.z();
+    return depth >= filter_config_.min_point_depth && depth <= filter_config_.max_point_depth &&
+           tri->parallax >= min_parallax;
+  };
+  std::vector<Eigen::Vector2d> positions, right_positions;
   std::vector<double> costs;
   std::vector<int> usable;
   std::vector<int> near;
   for (size_t k = 0; k < matches.size(); ++k) {
     const StereoMatch& m = matches[k];
     const Eigen::Vector2d& pl = left.raw[static_cast<size_t>(m.left)];
-    const Eigen::Vector2d& pr = right.raw[static_cast<size_t>(m.right)];
-    last_matches_.push_back(observation(0, pl, pr));
     const Eigen::Vector2d& ul = left.undistorted[static_cast<size_t>(m.left)];
-    const Eigen::Vector2d& ur = right.undistorted[static_cast<size_t>(m.right)];
-    const auto tri =
-        triangulateMidpoint(Kl_inv * Eigen::Vector3d(ul.x(), ul.y(), 1.0),
-                            Kr_inv * Eigen::Vector3d(ur.x(), ur.y(), 1.0), T_lopt_ropt);
-    if (!tri) continue;
-    const double depth = tri->point_left.z();
-    if (depth < filter_config_.min_point_depth || depth > filter_config_.max_point_depth ||
-        tri->parallax < min_parallax) {
+    if (!plausible(ul, right.undistorted[static_cast<size_t>(m.right)])) continue;
+    Eigen::Vector2d pr, ur;
+    if (!refine(pl, ul, right.raw[static_cast<size_t>(m.right)], &pr, &ur) || !plausible(ul, ur)) {
       continue;
     }
+    last_matches_.push_back(observation(0, pl, pr));
     near.clear();
     const Eigen::Vector2d r = Eigen::Vector2d::Constant(config_.min_distance_to_track);
     tracked_grid.query(pl - r, pl + r, &near);
@@ -134,8 +222,10 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     if (too_close) continue;
     usable.push_back(static_cast<int>(k));
     positions.push_back(pl);
+    right_positions.push_back(pr);
     costs.push_back(m.descriptor_distance);
   }
+  stats.stereo_matches = static_cast<int>(last_matches_.size());
 
   // 4. Bucketing and the caps: per frame and in the state (FilterConfig::max_points).
   const int room = filter_config_.max_points - static_cast<int>(observations.size());
@@ -146,11 +236,11 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   for (int u : kept) {
     const StereoMatch& m = matches[static_cast<size_t>(usable[static_cast<size_t>(u)])];
     const PointId id = next_id_++;
-    observations.push_back(observation(id, left.raw[static_cast<size_t>(m.left)],
-                                       right.raw[static_cast<size_t>(m.right)]));
+    observations.push_back(observation(id, positions[static_cast<size_t>(u)],
+                                       right_positions[static_cast<size_t>(u)]));
     last_new_.push_back(observations.back());
-    pending_.push_back(
-        {id, left.descriptors.row(m.left).clone(), right.descriptors.row(m.right).clone()});
+    pending_.push_back({id, left.descriptors.row(m.left).clone(),
+                        right.descriptors.row(m.right).clone(), positions[static_cast<size_t>(u)]});
   }
   stats.new_candidates = static_cast<int>(kept.size());
   if (statistics) *statistics = stats;
@@ -163,7 +253,9 @@ void StereoFrontEnd::commit(const FrameReport& report, const CalibrationFilter& 
     if (!filter.hasPoint(o.id)) tracker_.remove(o.id);
   }
   for (const Pending& p : pending_) {
-    if (filter.hasPoint(p.id)) tracker_.add(p.id, p.left_descriptor, p.right_descriptor);
+    if (filter.hasPoint(p.id)) {
+      tracker_.add(p.id, p.left_descriptor, p.right_descriptor, p.left_pixel);
+    }
   }
   pending_.clear();
 }
@@ -171,6 +263,8 @@ void StereoFrontEnd::commit(const FrameReport& report, const CalibrationFilter& 
 void StereoFrontEnd::reset() {
   tracker_.clear();
   pending_.clear();
+  previous_left_.release();
+  current_left_.release();
 }
 
 cv::Mat StereoFrontEnd::debugImage() const {

@@ -48,8 +48,10 @@ class StereoFrontEnd {
   const std::vector<StereoObservation>& lastTracked() const { return last_tracked_; }
   /// New candidates offered in the last pair (raw pixels, with their fresh ids).
   const std::vector<StereoObservation>& lastNewCandidates() const { return last_new_; }
-  /// All epipolar-guided matches of the last pair before the depth checks and bucketing
-  /// (raw pixels, id 0).
+  /// The epipolar-guided matches of the last pair that passed every check of a new point
+  /// (mutual descriptor match, depth range and parallax, sub-pixel alignment) before the
+  /// distance to tracks and bucketing select among them (raw pixels, refined right pixel,
+  /// id 0).
   const std::vector<StereoObservation>& lastStereoMatches() const { return last_matches_; }
   /// Search windows of the last pair.
   const std::vector<TrackWindow>& lastWindows() const { return last_windows_; }
@@ -74,9 +76,11 @@ class StereoFrontEnd {
   struct Pending {
     PointId id;
     cv::Mat left_descriptor, right_descriptor;
+    Eigen::Vector2d left_pixel;
   };
   std::vector<Pending> pending_;
   cv::Mat last_left_, last_right_;
+  cv::Mat previous_left_, current_left_;  ///< copies: the left images of the last two pairs
   std::vector<StereoObservation> last_tracked_, last_new_, last_matches_;
   std::vector<TrackWindow> last_windows_;
 };
