@@ -143,7 +143,7 @@ double FeatureSet::distance(int i, const FeatureSet& other, int j) const {
 }
 
 FeatureDetector::FeatureDetector(const FrontEndConfig& config) : config_(config) {
-  const int candidates = 3 * config.max_features;
+  const int candidates = 3 * config.max_features / 2;
   if (config.detector == "ORB") {
     auto orb =
         cv::ORB::create(candidates, static_cast<float>(config.orb_scale_factor), config.orb_levels,

@@ -39,6 +39,9 @@ std::vector<std::string> FrontEndConfig::validate() const {
   checkRange(&p, "patch_half_size", patch_half_size, 1, 15);
   checkRange(&p, "max_refinement_shift", max_refinement_shift, 0.0, 20.0, true);
   checkRange(&p, "max_temporal_shift", max_temporal_shift, 0.0, 20.0, true);
+  checkRange(&p, "min_search_ncc", min_search_ncc, -1.0, 1.0);
+  checkRange(&p, "max_forward_backward", max_forward_backward, 0.0, 10.0, true);
+  checkRange(&p, "discontinuity_search", discontinuity_search, 0, 20);
   checkRange(&p, "min_patch_ncc", min_patch_ncc, -1.0, 1.0);
   checkRange(&p, "min_patch_eigen_ratio", min_patch_eigen_ratio, 0.0, 1.0);
   checkRange(&p, "refined_pixel_sigma", refined_pixel_sigma, 0.0, 10.0, true);

@@ -9,29 +9,35 @@
 namespace osc {
 namespace {
 
-/// Bilinear sample of a mono8 image; false if (x, y) is outside [0, cols-1] x [0, rows-1].
-inline bool sample(const cv::Mat& image, double x, double y, float* value) {
-  if (!(x >= 0.0 && y >= 0.0 && x <= image.cols - 1.0 && y <= image.rows - 1.0)) return false;
-  int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  x0 = std::min(x0, image.cols - 2);
-  y0 = std::min(y0, image.rows - 2);
-  const float ax = static_cast<float>(x - x0), ay = static_cast<float>(y - y0);
-  const unsigned char* r0 = image.ptr<unsigned char>(y0) + x0;
-  const unsigned char* r1 = image.ptr<unsigned char>(y0 + 1) + x0;
-  const float top = r0[0] + ax * (r0[1] - r0[0]);
-  const float bottom = r1[0] + ax * (r1[1] - r1[0]);
-  *value = top + ay * (bottom - top);
-  return true;
-}
-
-/// Samples the (2h+1)^2 patch (plus a one-pixel rim when `rim`) centred at p.
+/// Samples the (2h+1)^2 patch centred at p (bilinear; the offset is the same for every
+/// pixel, so the weights are computed once). False if any sample falls outside the image.
 bool samplePatch(const cv::Mat& image, const Eigen::Vector2d& p, int h, std::vector<float>* out) {
   const int n = 2 * h + 1;
   out->resize(static_cast<size_t>(n * n));
-  size_t k = 0;
-  for (int dy = -h; dy <= h; ++dy) {
-    for (int dx = -h; dx <= h; ++dx) {
-      if (!sample(image, p.x() + dx, p.y() + dy, &(*out)[k++])) return false;
+  if (!(p.x() - h >= 0.0 && p.y() - h >= 0.0 && p.x() + h <= image.cols - 1.0 &&
+        p.y() + h <= image.rows - 1.0)) {
+    return false;
+  }
+  const double fx = std::floor(p.x()), fy = std::floor(p.y());
+  int x0 = static_cast<int>(fx) - h, y0 = static_cast<int>(fy) - h;
+  float ax = static_cast<float>(p.x() - fx), ay = static_cast<float>(p.y() - fy);
+  // At the last column / row the right / lower neighbour is not needed (weight 0).
+  if (x0 + n >= image.cols) {
+    --x0;
+    ax += 1.0f;
+  }
+  if (y0 + n >= image.rows) {
+    --y0;
+    ay += 1.0f;
+  }
+  const float w00 = (1.0f - ax) * (1.0f - ay), w01 = ax * (1.0f - ay);
+  const float w10 = (1.0f - ax) * ay, w11 = ax * ay;
+  float* o = out->data();
+  for (int y = 0; y < n; ++y) {
+    const unsigned char* r0 = image.ptr<unsigned char>(y0 + y) + x0;
+    const unsigned char* r1 = r0 + image.step[0];
+    for (int x = 0; x < n; ++x) {
+      *o++ = w00 * r0[x] + w01 * r0[x + 1] + w10 * r1[x] + w11 * r1[x + 1];
     }
   }
   return true;
@@ -47,10 +53,13 @@ PatchAlignment alignPatch(const cv::Mat& source, const Eigen::Vector2d& source_p
   const int h = config.half_size;
   const int n = 2 * h + 1;
   // Template with a one-pixel rim for its central-difference gradients.
-  std::vector<float> big;
+  // Scratch buffers reused across calls (one set per thread).
+  thread_local std::vector<float> big, tmpl, gx, gy, warped;
   if (!samplePatch(source, source_point, h + 1, &big)) return result;
   const int nb = n + 2;
-  std::vector<float> tmpl(static_cast<size_t>(n * n)), gx(tmpl.size()), gy(tmpl.size());
+  tmpl.resize(static_cast<size_t>(n * n));
+  gx.resize(tmpl.size());
+  gy.resize(tmpl.size());
   double mean_t = 0.0;
   for (int y = 0; y < n; ++y) {
     for (int x = 0; x < n; ++x) {
@@ -89,7 +98,6 @@ PatchAlignment alignPatch(const cv::Mat& source, const Eigen::Vector2d& source_p
 
   // Inverse compositional: warp W(x; p) = x + p; the template's warp is inverted each step.
   Eigen::Vector2d p = guess;
-  std::vector<float> warped;
   bool converged = false;
   for (int it = 0; it < config.max_iterations; ++it) {
     if (!samplePatch(target, p, h, &warped)) return result;
@@ -127,6 +135,93 @@ PatchAlignment alignPatch(const cv::Mat& source, const Eigen::Vector2d& source_p
   result.position = p;
   result.ok = result.ncc >= config.min_ncc;
   return result;
+}
+
+bool straddlesDepthDiscontinuity(const cv::Mat& source, const Eigen::Vector2d& source_point,
+                                 const cv::Mat& target, const Eigen::Vector2d& target_point,
+                                 const Eigen::Vector2d& direction, int half_size, int max_shift) {
+  const int h = half_size, n = 2 * h + 1;
+  thread_local std::vector<float> tmpl, shifted;
+  thread_local std::vector<double> ssd;  // [half][shift]
+  if (!samplePatch(source, source_point, h, &tmpl)) return false;
+  const int shifts = 2 * max_shift + 1;
+  ssd.assign(static_cast<size_t>(4 * shifts), 0.0);
+  // Halves: 0 left columns, 1 right columns, 2 upper rows, 3 lower rows (centre included).
+  auto inHalf = [h](int q, int x, int y) {
+    switch (q) {
+      case 0:
+        return x <= h;
+      case 1:
+        return x >= h;
+      case 2:
+        return y <= h;
+      default:
+        return y >= h;
+    }
+  };
+  const int count = (h + 1) * n;
+  double texture[4] = {0.0, 0.0, 0.0, 0.0};
+  for (int q = 0; q < 4; ++q) {
+    // Texture along the direction: variance of the directional derivative in the half.
+    double sum = 0.0, sum2 = 0.0;
+    for (int y = 0; y < n; ++y) {
+      for (int x = 1; x + 1 < n; ++x) {
+        if (!inHalf(q, x, y)) continue;
+        const size_t k = static_cast<size_t>(y * n + x);
+        const double gx = 0.5 * (tmpl[k + 1] - tmpl[k - 1]);
+        const double gy = (y > 0 && y + 1 < n) ? 0.5 * (tmpl[k + n] - tmpl[k - n]) : 0.0;
+        const double g = direction.x() * gx + direction.y() * gy;
+        sum += g;
+        sum2 += g * g;
+      }
+    }
+    texture[q] = sum2 - sum * sum / count;
+  }
+  for (int s = 0; s < shifts; ++s) {
+    const Eigen::Vector2d p = target_point + (s - max_shift) * direction;
+    if (!samplePatch(target, p, h, &shifted)) return false;
+    // Bias-compensated SSD per half: sum(e^2) - sum(e)^2 / count, one pass.
+    double se[4] = {0.0, 0.0, 0.0, 0.0}, se2[4] = {0.0, 0.0, 0.0, 0.0};
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        const size_t k = static_cast<size_t>(y * n + x);
+        const double e = shifted[k] - tmpl[k];
+        const double e2 = e * e;
+        if (x <= h) {
+          se[0] += e;
+          se2[0] += e2;
+        }
+        if (x >= h) {
+          se[1] += e;
+          se2[1] += e2;
+        }
+        if (y <= h) {
+          se[2] += e;
+          se2[2] += e2;
+        }
+        if (y >= h) {
+          se[3] += e;
+          se2[3] += e2;
+        }
+      }
+    }
+    for (int q = 0; q < 4; ++q) {
+      ssd[static_cast<size_t>(q * shifts + s)] = se2[q] - se[q] * se[q] / count;
+    }
+  }
+  // A half needs enough texture along the direction to tell its own shift: at least a
+  // quarter of the best-textured half's.
+  const double most = std::max(std::max(texture[0], texture[1]), std::max(texture[2], texture[3]));
+  for (int q = 0; q < 4; ++q) {
+    if (!(texture[q] > 0.25 * most) || !(most > 0.0)) continue;
+    const double* row = &ssd[static_cast<size_t>(q * shifts)];
+    int best = max_shift;
+    for (int s = 0; s < shifts; ++s) {
+      if (row[s] < row[best]) best = s;
+    }
+    if (std::abs(best - max_shift) >= 2 && row[best] < 0.5 * row[max_shift]) return true;
+  }
+  return false;
 }
 
 }  // namespace osc

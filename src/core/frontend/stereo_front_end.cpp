@@ -61,6 +61,7 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   last_new_.clear();
   last_matches_.clear();
   last_windows_.clear();
+  last_bands_.clear();
   pending_.clear();
 
   const FeatureSet left = detector_.detect(left_mono, left_camera_);
@@ -97,8 +98,27 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     *right_raw = a.position;
     *right_und = right_camera_.undistortPixel(a.position);
     const EpipolarMatcher::Lines lines = matcher_.lines(left_und);
-    return std::abs(lines.nominal.dot(right_und->homogeneous())) <=
-           matcher_.bandHalfWidth(lines, *right_und, config_.refined_pixel_sigma);
+    if (std::abs(lines.nominal.dot(right_und->homogeneous())) >
+        matcher_.bandHalfWidth(lines, *right_und, config_.refined_pixel_sigma)) {
+      return false;
+    }
+    return true;
+  };
+  // Pairs handed to the filter (tracked and new) are also checked for a depth discontinuity
+  // across their patch (costly, so not every match is).
+  auto continuous = [&](const Eigen::Vector2d& left_raw, const Eigen::Vector2d& left_und,
+                        const Eigen::Vector2d& right_raw, const Eigen::Vector2d& right_und) {
+    if (config_.discontinuity_search <= 0) return true;
+    // The epipolar direction at the right pixel (raw image, along the line).
+    const Eigen::Vector3d line = matcher_.lines(left_und).nominal;
+    const Eigen::Vector2d ahead = right_camera_.normalizedToPixel(
+        (right_camera_.K().inverse() *
+         (right_und + Eigen::Vector2d(line.y(), -line.x())).homogeneous())
+            .head<2>());
+    const Eigen::Vector2d dir = ahead - right_raw;
+    return !(dir.norm() > 1e-9 && straddlesDepthDiscontinuity(
+                                      left_mono, left_raw, right_mono, right_raw, dir.normalized(),
+                                      config_.patch_half_size, config_.discontinuity_search));
   };
 
   // 1. Tracking (Sec. II-C): windows from the filter's predictions and S.
@@ -126,7 +146,8 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
       }
       Eigen::Vector2d right_raw, right_und;
       if (!refine(left_raw, left_und, right.raw[static_cast<size_t>(m.right)], &right_raw,
-                  &right_und)) {
+                  &right_und) ||
+          !continuous(left_raw, left_und, right_raw, right_und)) {
         continue;
       }
       tracker_.setLeftPixel(m.id, left_raw);
@@ -137,7 +158,7 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   // the previous left image is searched directly around its predicted pixel (Lucas-Kanade
   // from the prediction, Sec. II-C's window and the filter's S as the gate), then in the
   // right image around the right prediction moved by the left innovation.
-  if (!previous_left_.empty()) {
+  if (config_.search_lost_tracks && !previous_left_.empty()) {
     std::unordered_set<PointId> observed;
     for (const StereoObservation& o : observations) observed.insert(o.id);
     for (const TrackWindow& w : last_windows_) {
@@ -146,9 +167,14 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
       if (!tracker_.leftPixel(w.id, &previous)) continue;
       PatchAlignmentConfig search = alignment;
       search.max_shift = w.left_half.maxCoeff();
+      search.min_ncc = config_.min_search_ncc;
       const PatchAlignment a =
           alignPatch(previous_left_, previous, left_mono, w.left_center, search);
       if (!a.ok) continue;
+      // Forward-backward: the found patch aligned back must land where the point was.
+      const PatchAlignment back =
+          alignPatch(left_mono, a.position, previous_left_, previous, search);
+      if (!back.ok || (back.position - previous).norm() > config_.max_forward_backward) continue;
       const Eigen::Vector2d left_raw = a.position;
       const Eigen::Vector2d left_und = left_camera_.undistortPixel(left_raw);
       const Eigen::Vector2d el = left_und - w.z.head<2>();
@@ -157,15 +183,21 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
           el.dot(S_ll.inverse() * el) > config_.track_gate_chi2_2dof) {
         continue;
       }
+      // The right prediction conditioned on the left pixel found (S's cross terms).
+      const Eigen::Matrix2d S_rl = w.S.bottomLeftCorner<2, 2>();
+      const Eigen::Matrix2d gain = S_rl * S_ll.inverse();
+      const Eigen::Vector2d r_mean = w.z.tail<2>() + gain * el;
+      const Eigen::Matrix2d r_cov = w.S.bottomRightCorner<2, 2>() - gain * S_rl.transpose();
+      const Eigen::Vector2d r_guess = right_camera_.normalizedToPixel(
+          (right_camera_.K().inverse() * r_mean.homogeneous()).head<2>());
       Eigen::Vector2d right_raw, right_und;
-      if (!refine(left_raw, left_und, w.right_center + (left_raw - w.left_center), &right_raw,
-                  &right_und, w.right_half.maxCoeff())) {
+      if (!refine(left_raw, left_und, r_guess, &right_raw, &right_und) ||
+          !continuous(left_raw, left_und, right_raw, right_und)) {
         continue;
       }
-      const Eigen::Vector2d er = right_und - w.z.tail<2>();
-      const Eigen::Matrix2d S_rr = w.S.bottomRightCorner<2, 2>();
-      if (!(S_rr.determinant() > 0.0) ||
-          er.dot(S_rr.inverse() * er) > config_.track_gate_chi2_2dof) {
+      const Eigen::Vector2d er = right_und - r_mean;
+      if (!(r_cov.determinant() > 0.0) ||
+          er.dot(r_cov.inverse() * er) > config_.track_gate_chi2_2dof) {
         continue;
       }
       tracker_.setLeftPixel(w.id, left_raw);
@@ -176,8 +208,28 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   stats.tracked = static_cast<int>(observations.size());
   stats.track_failures = static_cast<int>(tracker_.size()) - stats.tracked;
 
-  // 2. New points: epipolar-guided matching with the current x_camr (eq. 5-6).
-  const std::vector<StereoMatch> matches = matcher_.match(left, right, left_used, right_used);
+  // 2. New points: epipolar-guided matching with the current x_camr (eq. 5-6), only of the
+  // left keypoints that could become one (not in a bucket holding a tracked point, not near
+  // a tracked point) and only if the state has room.
+  const int room = filter_config_.max_points - static_cast<int>(observations.size());
+  const int max_new = std::max(0, std::min(config_.max_new_points_per_frame, room));
+  std::vector<char> left_excluded = left_used;
+  {
+    const int cols = config_.bucket_cols, rows = config_.bucket_rows;
+    auto cellOf = [&](const Eigen::Vector2d& p) {
+      const int c =
+          std::clamp(static_cast<int>(std::floor(p.x() * cols / left_mono.cols)), 0, cols - 1);
+      const int r =
+          std::clamp(static_cast<int>(std::floor(p.y() * rows / left_mono.rows)), 0, rows - 1);
+      return static_cast<size_t>(r * cols + c);
+    };
+    std::vector<char> blocked(static_cast<size_t>(cols * rows), 0);
+    for (const StereoObservation& o : observations) blocked[cellOf(o.left_pixel)] = 1;
+    for (size_t i = 0; i < left.size(); ++i) {
+      if (max_new == 0 || blocked[cellOf(left.raw[i])]) left_excluded[i] = 1;
+    }
+  }
+  const std::vector<StereoMatch> matches = matcher_.match(left, right, left_excluded, right_used);
 
   // 3. Reject what cannot make a good point: behind, too close / far, too little parallax,
   // not confirmed by the sub-pixel alignment, or where a tracked point already is.
@@ -228,23 +280,52 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   stats.stereo_matches = static_cast<int>(last_matches_.size());
 
   // 4. Bucketing and the caps: per frame and in the state (FilterConfig::max_points).
-  const int room = filter_config_.max_points - static_cast<int>(observations.size());
-  const int max_new = std::max(0, std::min(config_.max_new_points_per_frame, room));
   const std::vector<int> kept =
       selectByBuckets(positions, costs, tracked_pixels, left_mono.cols, left_mono.rows,
                       config_.bucket_cols, config_.bucket_rows, max_new);
   for (int u : kept) {
     const StereoMatch& m = matches[static_cast<size_t>(usable[static_cast<size_t>(u)])];
+    if (!continuous(positions[static_cast<size_t>(u)],
+                    left.undistorted[static_cast<size_t>(m.left)],
+                    right_positions[static_cast<size_t>(u)],
+                    right_camera_.undistortPixel(right_positions[static_cast<size_t>(u)]))) {
+      continue;
+    }
     const PointId id = next_id_++;
     observations.push_back(observation(id, positions[static_cast<size_t>(u)],
                                        right_positions[static_cast<size_t>(u)]));
     last_new_.push_back(observations.back());
+    last_bands_.push_back(
+        bandPolylines(left.undistorted[static_cast<size_t>(m.left)],
+                      right_camera_.undistortPixel(right_positions[static_cast<size_t>(u)])));
     pending_.push_back({id, left.descriptors.row(m.left).clone(),
                         right.descriptors.row(m.right).clone(), positions[static_cast<size_t>(u)]});
   }
-  stats.new_candidates = static_cast<int>(kept.size());
+  stats.new_candidates = static_cast<int>(last_new_.size());
   if (statistics) *statistics = stats;
   return observations;
+}
+
+StereoFrontEnd::EpipolarBand StereoFrontEnd::bandPolylines(const Eigen::Vector2d& left_und,
+                                                           const Eigen::Vector2d& right_und) const {
+  // The band around the epipolar line of the left pixel near the match (eq. 5-6), +-60 px
+  // along the line, in raw right pixels (the line is curved there under distortion).
+  EpipolarBand band;
+  const EpipolarMatcher::Lines lines = matcher_.lines(left_und);
+  const Eigen::Vector3d& l = lines.nominal;
+  const double half = matcher_.bandHalfWidth(lines, right_und);
+  const Eigen::Vector2d normal(l.x(), l.y()), along(l.y(), -l.x());
+  const Eigen::Vector2d foot = right_und - l.dot(right_und.homogeneous()) * normal;
+  const Eigen::Matrix3d K_inv = right_camera_.K().inverse();
+  for (double t = -60.0; t <= 60.0; t += 10.0) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2d u = foot + t * along + (k - 1) * half * normal;
+      const Eigen::Vector2d raw =
+          right_camera_.normalizedToPixel((K_inv * u.homogeneous()).head<2>());
+      band.lines[k].emplace_back(static_cast<float>(raw.x()), static_cast<float>(raw.y()));
+    }
+  }
+  return band;
 }
 
 void StereoFrontEnd::commit(const FrameReport& report, const CalibrationFilter& filter) {
@@ -291,6 +372,18 @@ cv::Mat StereoFrontEnd::debugImage() const {
                   yellow, 1);
     cv::rectangle(canvas, pt(win.right_center - win.right_half, w),
                   pt(win.right_center + win.right_half, w), cyan, 1);
+  }
+  // Epipolar bands (eq. 5-6) of the new points in the right image: centre line and edges.
+  const cv::Scalar magenta(200, 0, 200);
+  for (const EpipolarBand& band : last_bands_) {
+    for (int k = 0; k < 3; ++k) {
+      std::vector<cv::Point> poly;
+      for (const cv::Point2f& p : band.lines[k]) {
+        poly.emplace_back(static_cast<int>(std::lround(p.x + w)),
+                          static_cast<int>(std::lround(p.y)));
+      }
+      cv::polylines(canvas, poly, false, magenta, 1, k == 1 ? cv::LINE_8 : cv::LINE_4);
+    }
   }
   for (const StereoObservation& o : last_new_) {
     cv::circle(canvas, pt(o.left_pixel), 4, blue, 2);

@@ -57,6 +57,18 @@ struct FrontEndConfig {
   /// Least normalised cross-correlation of the aligned patches, [-1, 1]: below, the two
   /// views show different things there (an occluding edge, a wrong match).
   double min_patch_ncc = 0.9;
+  /// Search tracks whose keypoint was not detected again by aligning their patch from the
+  /// previous left image at the predicted pixel (more tracks survive, at some precision).
+  bool search_lost_tracks = false;
+  /// ... least NCC there, [-1, 1], and largest forward-backward error (px, aligned back
+  /// into the previous image), (0, 10].
+  double min_search_ncc = 0.95;
+  double max_forward_backward = 0.3;
+  /// Depth-discontinuity check of every refined pair: each half of the patch is matched at
+  /// shifts of up to this many px along the epipolar line; a textured half that prefers a
+  /// shift of >= 2 px means the pixel and its neighbours lie at different depths (an
+  /// occluding contour) and the pair is rejected. [0, 20]; 0 = off.
+  int discontinuity_search = 8;
   /// Least ratio of the smaller to the larger eigenvalue of the patch's structure tensor,
   /// [0, 1]: below, the patch is a straight edge (its position along the edge is unknown).
   double min_patch_eigen_ratio = 0.05;

@@ -34,4 +34,13 @@ PatchAlignment alignPatch(const cv::Mat& source, const Eigen::Vector2d& source_p
                           const cv::Mat& target, const Eigen::Vector2d& guess,
                           const PatchAlignmentConfig& config);
 
+/// True if the aligned pair of patches straddles a depth discontinuity: some half of the
+/// patch (left, right, upper, lower) that is textured along `direction` (unit, the epipolar
+/// direction in the target) matches clearly better at a shift of >= 2 px along it (search
+/// +-max_shift px) than at the aligned position, i.e. the two halves have different
+/// disparities (an occluding contour: the pixel and the feature belong to different surfaces).
+bool straddlesDepthDiscontinuity(const cv::Mat& source, const Eigen::Vector2d& source_point,
+                                 const cv::Mat& target, const Eigen::Vector2d& target_point,
+                                 const Eigen::Vector2d& direction, int half_size, int max_shift);
+
 }  // namespace osc

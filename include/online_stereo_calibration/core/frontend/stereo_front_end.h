@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
 
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
@@ -58,8 +59,10 @@ class StereoFrontEnd {
   /// Points being tracked.
   size_t trackCount() const { return tracker_.size(); }
 
-  /// The last pair side by side (BGR): tracks green, new candidates blue, other stereo
-  /// matches grey, search windows yellow (left) / cyan (right). Empty before the first pair.
+  /// The last pair side by side (BGR): tracks green, new candidates blue with their
+  /// epipolar bands (centre line and band edges, eq. 5-6) magenta in the right image, other
+  /// stereo matches grey, search windows yellow (left) / cyan (right). Empty before the
+  /// first pair.
   cv::Mat debugImage() const;
 
   const FrontEndConfig& config() const { return config_; }
@@ -73,6 +76,13 @@ class StereoFrontEnd {
   PointTracker tracker_;
   PointId next_id_ = 1;
 
+  /// Polylines (raw right pixels) of one epipolar band: lower edge, centre, upper edge.
+  struct EpipolarBand {
+    std::vector<cv::Point2f> lines[3];
+  };
+  EpipolarBand bandPolylines(const Eigen::Vector2d& left_undistorted,
+                             const Eigen::Vector2d& right_undistorted) const;
+
   struct Pending {
     PointId id;
     cv::Mat left_descriptor, right_descriptor;
@@ -83,6 +93,7 @@ class StereoFrontEnd {
   cv::Mat previous_left_, current_left_;  ///< copies: the left images of the last two pairs
   std::vector<StereoObservation> last_tracked_, last_new_, last_matches_;
   std::vector<TrackWindow> last_windows_;
+  std::vector<EpipolarBand> last_bands_;
 };
 
 }  // namespace osc
