@@ -137,6 +137,20 @@ TEST(FrontEnd, MatchesAndTracksAreCorrectOnRenderedDrive) {
   expectGoodDrive(f, frames, 0.99);
 }
 
+TEST(FrontEnd, SearchingLostTracksKeepsMoreTracksAtTheSameStereoPrecision) {
+  // Off by default: measured (20 frames) 1165 tracks instead of 590 and stereo pairs 97.1 %
+  // correct (96.6 % without), but only 92.2 % on their birth point (94.4 %): LK from the
+  // prediction lets tracks on the near ground drift.
+  const int frames = 20;
+  FrontEndConfig with_search;
+  with_search.search_lost_tracks = true;
+  const DriveFigures f = drive(shortDrive(frames), confidentConfig(), with_search);
+  EXPECT_GE(f.tracks, 50 * frames);
+  EXPECT_GE(f.tracks_stereo_correct, 0.95 * f.tracks_reported);
+  EXPECT_GE(f.tracks_correct, 0.90 * f.tracks);
+  EXPECT_GE(f.final_points, 80);
+}
+
 TEST(FrontEnd, PlumbBobDistortedRawImages) {
   MeasurementScenario s = shortDrive(20);
   for (CameraIntrinsics* k : {&s.left, &s.right}) {
