@@ -209,8 +209,8 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   stats.track_failures = static_cast<int>(tracker_.size()) - stats.tracked;
 
   // 2. New points: epipolar-guided matching with the current x_camr (eq. 5-6), only of the
-  // left keypoints that could become one (not in a bucket holding a tracked point, not near
-  // a tracked point) and only if the state has room.
+  // left keypoints that could become one (not in a bucket holding a tracked point: the
+  // bucketing below would refuse them) and only if the state has room.
   const int room = filter_config_.max_points - static_cast<int>(observations.size());
   const int max_new = std::max(0, std::min(config_.max_new_points_per_frame, room));
   std::vector<char> left_excluded = left_used;
