@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@
 
 #include "online_stereo_calibration/core/frontend/bucketing.h"
 #include "online_stereo_calibration/core/frontend/feature_detection.h"
+#include "online_stereo_calibration/core/frontend/patch_alignment.h"
 #include "online_stereo_calibration/core/frontend/stereo_front_end.h"
 #include "online_stereo_calibration/core/geometry/stereo_geometry.h"
 #include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
@@ -81,19 +84,25 @@ DriveFigures drive(const MeasurementScenario& scenario, const FilterConfig& filt
   return f;
 }
 
-/// NOT YET AT TARGET: the brief asks for >= 99 % stereo-match and tracking precision. The
-/// front end measures ~96 % (matches; 92 % with distorted lenses), ~88 % (tracks, stereo
-/// pair correct; 83 % distorted) and ~77 % (tracks still on the point seen at their birth)
-/// on the rendered drive. The bars below are the measured figures minus a margin, so a
-/// regression still fails; raise them when the precision is fixed.
-void expectGoodDrive(const DriveFigures& f, int frames) {
+/// Bars of a rendered drive. The targets are >= 99 % correct stereo matches and
+/// tracks and >= 50 points alive.
+/// - Stereo matches (every match that passed the checks of a new point): >= 99 % on the
+///   pinhole drive (measured 99.3 %); 98.5 % with distorted lenses (measured 99.0 %).
+/// - NOT YET AT TARGET: tracks (stereo pair correct: measured 95-96.6 %; still on their
+///   birth point: 94-95 %) and new points (97.5-98.5 %). Nearly every remaining wrong track
+///   is a keypoint on an occluding contour: the pixel sees the sky or a distant featureless
+///   surface while the feature is the outline of a nearer object (cone tips, box tops), so
+///   the pixel's own surface point does not project where the right feature is. Neither the
+///   patch NCC nor the split-patch disparity check sees it (the background has no texture).
+///   The bars are the measured figures minus a margin.
+void expectGoodDrive(const DriveFigures& f, int frames, double match_precision) {
   EXPECT_EQ(f.processed, frames);
   EXPECT_GE(f.matches, 100 * frames);
-  EXPECT_GE(f.matches_correct, 0.85 * f.matches);
-  EXPECT_GE(f.new_correct, 0.85 * f.new_points);
-  EXPECT_GE(f.tracks, 30 * frames);
-  EXPECT_GE(f.tracks_correct, 0.55 * f.tracks);
-  EXPECT_GE(f.tracks_stereo_correct, 0.75 * f.tracks_reported);
+  EXPECT_GE(f.matches_correct, match_precision * f.matches);
+  EXPECT_GE(f.new_correct, 0.96 * f.new_points);
+  EXPECT_GE(f.tracks, 25 * frames);
+  EXPECT_GE(f.tracks_correct, 0.92 * f.tracks);
+  EXPECT_GE(f.tracks_stereo_correct, 0.93 * f.tracks_reported);
   EXPECT_GE(f.final_points, 50);
 }
 
@@ -125,7 +134,21 @@ TEST(Bucketing, KeepsTheBestPerFreeCellUpToTheCap) {
 TEST(FrontEnd, MatchesAndTracksAreCorrectOnRenderedDrive) {
   const int frames = 25;
   const DriveFigures f = drive(shortDrive(frames), confidentConfig(), FrontEndConfig());
-  expectGoodDrive(f, frames);
+  expectGoodDrive(f, frames, 0.99);
+}
+
+TEST(FrontEnd, SearchingLostTracksKeepsMoreTracksAtTheSameStereoPrecision) {
+  // Off by default: measured (20 frames) 1165 tracks instead of 590 and stereo pairs 97.1 %
+  // correct (96.6 % without), but only 92.2 % on their birth point (94.4 %): LK from the
+  // prediction lets tracks on the near ground drift.
+  const int frames = 20;
+  FrontEndConfig with_search;
+  with_search.search_lost_tracks = true;
+  const DriveFigures f = drive(shortDrive(frames), confidentConfig(), with_search);
+  EXPECT_GE(f.tracks, 50 * frames);
+  EXPECT_GE(f.tracks_stereo_correct, 0.95 * f.tracks_reported);
+  EXPECT_GE(f.tracks_correct, 0.90 * f.tracks);
+  EXPECT_GE(f.final_points, 80);
 }
 
 TEST(FrontEnd, PlumbBobDistortedRawImages) {
@@ -134,7 +157,7 @@ TEST(FrontEnd, PlumbBobDistortedRawImages) {
     k->model = DistortionModel::kPlumbBob;
     k->distortion = {-0.28, 0.074, 0.0002, 0.00002, 0.0};
   }
-  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), 20);
+  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), 20, 0.985);
 }
 
 TEST(FrontEnd, EquidistantDistortedRawImages) {
@@ -143,7 +166,7 @@ TEST(FrontEnd, EquidistantDistortedRawImages) {
     k->model = DistortionModel::kEquidistant;
     k->distortion = {-0.01, 0.005, -0.002, 0.0};
   }
-  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), 20);
+  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), 20, 0.985);
 }
 
 TEST(FrontEnd, WrongCalibrationBandStillFindsCorrectMatches) {
@@ -160,7 +183,84 @@ TEST(FrontEnd, WrongCalibrationBandStillFindsCorrectMatches) {
   std::printf("  wrong calibration: %d matches, %d correct\n", first.matches_checked,
               first.matches_correct);
   EXPECT_GE(first.matches_checked, 100);
-  EXPECT_GE(first.matches_correct, 0.9 * first.matches_checked);
+  // NOT YET AT TARGET (99 %): measured 98.4 % (1097 of 1115) in the first, widest band.
+  EXPECT_GE(first.matches_correct, 0.975 * first.matches_checked);
+}
+
+/// A smooth random texture (blurred noise), mono8.
+cv::Mat texture(int width, int height, int seed) {
+  cv::Mat noise(height, width, CV_8UC1);
+  cv::RNG rng(static_cast<uint64_t>(seed));
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+  cv::Mat smooth;
+  cv::GaussianBlur(noise, smooth, cv::Size(0, 0), 1.5);
+  cv::normalize(smooth, smooth, 0, 255, cv::NORM_MINMAX);
+  return smooth;
+}
+
+TEST(PatchAlignment, RecoversASubPixelShiftAndBrightnessOffset) {
+  const cv::Mat source = texture(120, 100, 1);
+  // target(x) = source(x - shift) + 20 grey levels.
+  const Eigen::Vector2d shift(1.3, -0.7);
+  const cv::Mat M = (cv::Mat_<double>(2, 3) << 1, 0, shift.x(), 0, 1, shift.y());
+  cv::Mat target;
+  cv::warpAffine(source, target, M, source.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  target += cv::Scalar(20);
+  PatchAlignmentConfig config;
+  for (const Eigen::Vector2d& p : {Eigen::Vector2d(40, 50), Eigen::Vector2d(70.4, 33.6)}) {
+    // Started from the nearest integer pixel, as from a keypoint.
+    const Eigen::Vector2d guess = (p + shift).array().round().matrix();
+    const PatchAlignment a = alignPatch(source, p, target, guess, config);
+    ASSERT_TRUE(a.ok) << "ncc " << a.ncc << " eigen ratio " << a.eigen_ratio;
+    EXPECT_NEAR(a.position.x(), p.x() + shift.x(), 0.1);
+    EXPECT_NEAR(a.position.y(), p.y() + shift.y(), 0.1);
+    EXPECT_GT(a.ncc, 0.99);
+  }
+  // Beyond max_shift from the guess: refused.
+  config.max_shift = 1.0;
+  EXPECT_FALSE(
+      alignPatch(source, Eigen::Vector2d(40, 50), target, Eigen::Vector2d(40, 50), config).ok);
+}
+
+TEST(PatchAlignment, RefusesStraightEdgesAndDifferentContent) {
+  // A vertical step edge: its position along the edge is unknown (aperture problem).
+  cv::Mat edge(60, 60, CV_8UC1, cv::Scalar(40));
+  edge.colRange(30, 60).setTo(200);
+  const PatchAlignment a = alignPatch(edge, Eigen::Vector2d(30, 30), edge, Eigen::Vector2d(30, 30),
+                                      PatchAlignmentConfig());
+  EXPECT_FALSE(a.ok);
+  EXPECT_LT(a.eigen_ratio, 0.05);
+  // Unrelated textures: low NCC.
+  const PatchAlignment b =
+      alignPatch(texture(60, 60, 2), Eigen::Vector2d(30, 30), texture(60, 60, 3),
+                 Eigen::Vector2d(30, 30), PatchAlignmentConfig());
+  EXPECT_FALSE(b.ok);
+}
+
+TEST(PatchAlignment, SeesADepthDiscontinuityAcrossThePatch) {
+  // Left view: a textured foreground over the left half of the image in front of a textured
+  // background. Right view: the foreground moves 6 px, the background 1 px.
+  const cv::Mat background = texture(140, 80, 4), foreground = texture(140, 80, 5);
+  auto view = [&](double fg_shift, double bg_shift) {
+    cv::Mat bg, fg;
+    const cv::Mat Mb = (cv::Mat_<double>(2, 3) << 1, 0, -bg_shift, 0, 1, 0);
+    const cv::Mat Mf = (cv::Mat_<double>(2, 3) << 1, 0, -fg_shift, 0, 1, 0);
+    cv::warpAffine(background, bg, Mb, background.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+    cv::warpAffine(foreground, fg, Mf, foreground.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+    const int edge = static_cast<int>(std::lround(70 - fg_shift));
+    fg.colRange(0, edge).copyTo(bg.colRange(0, edge));
+    return bg;
+  };
+  const cv::Mat left = view(0.0, 0.0), right = view(6.0, 1.0);
+  const Eigen::Vector2d along(-1.0, 0.0);  // positive disparity: right pixel = left - d
+  // On the contour: the foreground half wants -6 px, the background half -1 px.
+  EXPECT_TRUE(straddlesDepthDiscontinuity(left, Eigen::Vector2d(70, 40), right,
+                                          Eigen::Vector2d(64, 40), along, 4, 8));
+  // Inside the foreground and inside the background: one disparity.
+  EXPECT_FALSE(straddlesDepthDiscontinuity(left, Eigen::Vector2d(40, 40), right,
+                                           Eigen::Vector2d(34, 40), along, 4, 8));
+  EXPECT_FALSE(straddlesDepthDiscontinuity(left, Eigen::Vector2d(110, 40), right,
+                                           Eigen::Vector2d(109, 40), along, 4, 8));
 }
 
 class BadImages : public ::testing::Test {
@@ -296,6 +396,163 @@ TEST(FrontEndEuroc, EpipolarGuidedMatchingOnRealImages) {
     EXPECT_LE(median_sampson, 0.3);
     EXPECT_GE(plausible, 0.95 * matches.size());
   }
+}
+
+// ---- diagnostics (temporary) ----
+struct DiagCtx {
+  const StereoSceneRenderer* renderer;
+  const CameraModel* left;
+  const CameraModel* right;
+  Eigen::Isometry3d Tl, Tr;
+};
+// depth (m, along optical z) of the surface seen at a pixel, -1 for sky
+double diagDepth(const DiagCtx& c, const CameraModel& cam, const Eigen::Isometry3d& T,
+                 const Eigen::Vector2d& px) {
+  const auto p = c.renderer->surfacePoint(cam, T, px);
+  if (!p) return -1.0;
+  return (T.inverse() * *p).z();
+}
+// largest relative depth change within r px around px
+double diagEdge(const DiagCtx& c, const CameraModel& cam, const Eigen::Isometry3d& T,
+                const Eigen::Vector2d& px, double r) {
+  const double d0 = diagDepth(c, cam, T, px);
+  double worst = 0.0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const double d = diagDepth(c, cam, T, px + r * Eigen::Vector2d(dx, dy));
+      if (d0 < 0 || d < 0) {
+        if ((d0 < 0) != (d < 0)) worst = std::max(worst, 10.0);
+        continue;
+      }
+      worst = std::max(worst, std::abs(d - d0) / d0);
+    }
+  return worst;
+}
+// prints one line about a pair; returns error (px) or -1 if not visible
+double diagPair(const DiagCtx& c, const char* tag, const Eigen::Vector2d& pl,
+                const Eigen::Vector2d& pr, bool print_ok) {
+  const auto p = c.renderer->surfacePoint(*c.left, c.Tl, pl);
+  Eigen::Vector2d proj(-1, -1);
+  bool vis = false;
+  if (p) vis = c.renderer->projectVisible(*c.right, c.Tr, *p, &proj);
+  const double err = p ? (proj - pr).norm() : -1.0;
+  const bool ok = vis && err <= 1.5;
+  if (ok && !print_ok) return err;
+  const double depth = diagDepth(c, *c.left, c.Tl, pl);
+  std::printf(
+      "%s %s L(%.0f,%.0f) R(%.1f,%.1f) true(%.1f,%.1f) vis %d err %.2f dx %.2f dy %.2f depth %.1f "
+      "edgeL %.2f edgeR %.2f\n",
+      tag, ok ? "OK " : "BAD", pl.x(), pl.y(), pr.x(), pr.y(), proj.x(), proj.y(), vis, err,
+      pr.x() - proj.x(), pr.y() - proj.y(), depth, diagEdge(c, *c.left, c.Tl, pl, 2.0),
+      diagEdge(c, *c.right, c.Tr, pr, 2.0));
+  return err;
+}
+
+/// Diagnostics, not a check (run with --gtest_also_run_disabled_tests): prints every wrong
+/// stereo match (M) and track (T) with its true pixel, error along/across the line, depth
+/// and depth discontinuity around the pixel (edgeL/R: largest relative depth change within
+/// 2 px; 10 = sky), every track off its birth point (B), and a SUMMARY. Environment:
+/// DIAG_FRAMES, DIAG_DISTORT, D_QUIET, D_IMG (debug image of frame 5) and D_* overrides of
+/// the FrontEndConfig.
+TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
+  const int frames = std::getenv("DIAG_FRAMES") ? std::atoi(std::getenv("DIAG_FRAMES")) : 25;
+  MeasurementScenario s = shortDrive(frames);
+  if (std::getenv("DIAG_DISTORT")) {
+    for (CameraIntrinsics* k : {&s.left, &s.right}) {
+      k->model = DistortionModel::kPlumbBob;
+      k->distortion = {-0.28, 0.074, 0.0002, 0.00002, 0.0};
+    }
+  }
+  MeasurementSimulator sim(s);
+  ImageScenarioOptions options;
+  SceneConfig scene = options.scene;
+  scene.path.clear();
+  const double duration = s.frames / s.rate_hz;
+  const double speed = std::max(s.motion.speed, 0.1);
+  const int samples = std::max(2, static_cast<int>(std::ceil(duration * speed)) + 1);
+  for (int i = 0; i <= samples; ++i)
+    scene.path.push_back(sim.trajectory().groundPosition(duration * i / samples));
+  const StereoSceneRenderer renderer(scene);
+  DiagCtx c{&renderer, &sim.leftCamera(), &sim.rightCamera(), {}, {}};
+  FrontEndConfig fe;
+  auto envd = [](const char* n, double* v) {
+    if (std::getenv(n)) *v = std::atof(std::getenv(n));
+  };
+  auto envi = [](const char* n, int* v) {
+    if (std::getenv(n)) *v = std::atoi(std::getenv(n));
+  };
+  if (std::getenv("D_DET")) fe.detector = std::getenv("D_DET");
+  envi("D_MAXF", &fe.max_features);
+  envi("D_FAST", &fe.fast_threshold);
+  envd("D_RATIO", &fe.ratio);
+  envd("D_TRATIO", &fe.track_ratio);
+  envd("D_NCC", &fe.min_patch_ncc);
+  if (std::getenv("D_SEARCH")) fe.search_lost_tracks = true;
+  envi("D_DISC", &fe.discontinuity_search);
+  envd("D_SNCC", &fe.min_search_ncc);
+  envd("D_FB", &fe.max_forward_backward);
+  envd("D_EIG", &fe.min_patch_eigen_ratio);
+  envd("D_MAXD", &fe.max_descriptor_distance);
+  envd("D_TMAXD", &fe.max_track_descriptor_distance);
+  envi("D_HALF", &fe.patch_half_size);
+  const bool quiet = std::getenv("D_QUIET") != nullptr;
+  DriveFigures f;
+  std::map<PointId, std::pair<Eigen::Vector3d, int>> births;
+  runImageScenario(
+      s, confidentConfig(), fe, options,
+      [&](const ImageFrameResult& r, const CalibrationPipeline& pipeline) {
+        SimulatedFrame frame;
+        sim.nextFrame(&frame);
+        c.Tl = frame.T_world_veh * frame.truth.vehicleToLeftOptical();
+        c.Tr = c.Tl * frame.truth.leftToRightOptical();
+        f.matches += r.matches_checked;
+        f.matches_correct += r.matches_correct;
+        f.tracks += r.tracks_checked;
+        f.tracks_correct += r.tracks_correct;
+        f.tracks_reported += r.tracks_reported;
+        f.tracks_stereo_correct += r.tracks_stereo_correct;
+        f.new_points += r.new_checked;
+        f.new_correct += r.new_correct;
+        f.final_points = r.filter.tracked_points;
+        std::printf("FRAME %d matches %d/%d tracks %d/%d birth %d/%d points %d\n", r.filter.frame,
+                    r.matches_correct, r.matches_checked, r.tracks_stereo_correct,
+                    r.tracks_reported, r.tracks_correct, r.tracks_checked, r.filter.tracked_points);
+        for (const auto& o : pipeline.frontEnd().lastTracked()) {
+          auto it = births.find(o.id);
+          if (it == births.end()) continue;
+          Eigen::Vector2d pl, pr;
+          const bool vl = renderer.projectVisible(*c.left, c.Tl, it->second.first, &pl);
+          const bool vr = renderer.projectVisible(*c.right, c.Tr, it->second.first, &pr);
+          const double el = (pl - o.left_pixel).norm(), er = (pr - o.right_pixel).norm();
+          if (!(vl && vr && el <= 1.5 && er <= 1.5) && !quiet)
+            std::printf(
+                "B id %lu age %d vis %d%d L(%.0f,%.0f) errL %.2f (%.2f,%.2f) errR %.2f depth %.1f "
+                "edgeL %.2f\n",
+                (unsigned long)o.id, r.filter.frame - it->second.second, vl, vr, o.left_pixel.x(),
+                o.left_pixel.y(), el, o.left_pixel.x() - pl.x(), o.left_pixel.y() - pl.y(), er,
+                diagDepth(c, *c.left, c.Tl, o.left_pixel),
+                diagEdge(c, *c.left, c.Tl, o.left_pixel, 2.0));
+        }
+        for (const auto& o : pipeline.frontEnd().lastNewCandidates()) {
+          if (!pipeline.estimator().filter().hasPoint(o.id)) continue;
+          const auto p = renderer.surfacePoint(*c.left, c.Tl, o.left_pixel);
+          if (p) births[o.id] = {*p, r.filter.frame};
+        }
+        if (std::getenv("D_IMG") && r.filter.frame == 5)
+          cv::imwrite(std::getenv("D_IMG"), pipeline.debugImage());
+        if (quiet) return;
+        for (const auto& o : pipeline.frontEnd().lastStereoMatches())
+          diagPair(c, "M", o.left_pixel, o.right_pixel, false);
+        for (const auto& o : pipeline.frontEnd().lastTracked())
+          diagPair(c, "T", o.left_pixel, o.right_pixel, false);
+      });
+  std::printf(
+      "SUMMARY matches %d (%.2f %%) new %d (%.2f %%) tracks %d (stereo %.2f %%, birth %.2f %% of "
+      "%d) points %d\n",
+      f.matches, 100.0 * f.matches_correct / std::max(1, f.matches), f.new_points,
+      100.0 * f.new_correct / std::max(1, f.new_points), f.tracks_reported,
+      100.0 * f.tracks_stereo_correct / std::max(1, f.tracks_reported),
+      100.0 * f.tracks_correct / std::max(1, f.tracks), f.tracks, f.final_points);
 }
 
 }  // namespace

@@ -52,6 +52,11 @@ TEST(ImagePipeline, ConvergesOnAShortRenderedDrive) {
   EXPECT_LT(e.segment<3>(3).norm(), 1.0 * kDeg);   // x_caml rotation
   EXPECT_LT(last.filter.nees, 3.0 * 12.0);         // not overconfident
   EXPECT_GE(last.filter.tracked_points, 50);
+  // Front end over the whole run: stereo matches at the 99 % (measured 99.26 %);
+  // tracks still on their birth point NOT YET AT TARGET (measured 95.85 %; outlines against
+  // the sky, see docs/RESULTS.md).
+  EXPECT_GE(matches_correct, 0.99 * matches);
+  EXPECT_GE(tracks_correct, 0.93 * tracks);
 }
 
 }  // namespace

@@ -27,8 +27,8 @@ bool projectRight(const Eigen::Matrix3d& K, const Eigen::Vector3d& p, Eigen::Vec
 
 }  // namespace
 
-EpipolarMatcher::EpipolarMatcher(const FrontEndConfig& config, double min_depth)
-    : config_(config), min_depth_(min_depth) {
+EpipolarMatcher::EpipolarMatcher(const FrontEndConfig& config, double min_depth, double max_depth)
+    : config_(config), min_depth_(min_depth), max_depth_(max_depth) {
   setGeometry(Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity(),
               Eigen::Isometry3d::Identity(), Matrix6d::Zero());
 }
@@ -52,24 +52,44 @@ void EpipolarMatcher::setGeometry(const Eigen::Matrix3d& K_left, const Eigen::Ma
   }
 }
 
-double EpipolarMatcher::bandHalfWidth(const Eigen::Vector2d& left,
-                                      const Eigen::Vector2d& right) const {
+EpipolarMatcher::Lines EpipolarMatcher::lines(const Eigen::Vector2d& left) const {
+  Lines l;
+  l.nominal = epipolarLine(F_, left);  // eq. 6
+  for (int j = 0; j < 6; ++j) l.sigma[j] = epipolarLine(F_sigma_[j], left);
+  return l;
+}
+
+double EpipolarMatcher::bandHalfWidth(const Lines& lines, const Eigen::Vector2d& right) const {
+  return bandHalfWidth(lines, right, config_.pixel_sigma);
+}
+
+double EpipolarMatcher::bandHalfWidth(const Lines& lines, const Eigen::Vector2d& right,
+                                      double pixel_sigma) const {
   const Eigen::Vector3d r(right.x(), right.y(), 1.0);
-  const double d0 = epipolarLine(F_, left).dot(r);  // eq. 6
-  double variance = 2.0 * config_.pixel_sigma * config_.pixel_sigma;
+  const double d0 = lines.nominal.dot(r);
+  double variance = 2.0 * pixel_sigma * pixel_sigma;
   for (int j = 0; j < 6; ++j) {
-    const double dj = epipolarLine(F_sigma_[j], left).dot(r) - d0;
+    const double dj = lines.sigma[j].dot(r) - d0;
     variance += dj * dj;
   }
   return std::clamp(config_.band_sigmas * std::sqrt(variance), config_.min_band, config_.max_band);
+}
+
+double EpipolarMatcher::bandHalfWidth(const Eigen::Vector2d& left,
+                                      const Eigen::Vector2d& right) const {
+  return bandHalfWidth(lines(left), right);
 }
 
 std::vector<StereoMatch> EpipolarMatcher::match(const FeatureSet& left, const FeatureSet& right,
                                                 const std::vector<char>& left_used,
                                                 const std::vector<char>& right_used) const {
   const double inf = std::numeric_limits<double>::infinity();
-  // Best proposal per right keypoint (one-to-one: the smaller descriptor distance wins).
-  std::vector<StereoMatch> best_for_right(right.size());
+  // The best proposal of each left keypoint, and per right keypoint the best and second
+  // best left keypoint among all whose band it lies in (for the mutual check).
+  std::vector<StereoMatch> best_of_left(left.size());
+  std::vector<double> second_of_left(left.size(), inf);
+  std::vector<int> right_best(right.size(), -1);
+  std::vector<double> right_best_distance(right.size(), inf), right_second(right.size(), inf);
   std::vector<int> stamp(right.size(), -1);
   std::vector<int> candidates;
   const double pixel_var = 2.0 * config_.pixel_sigma * config_.pixel_sigma;
@@ -78,10 +98,15 @@ std::vector<StereoMatch> EpipolarMatcher::match(const FeatureSet& left, const Fe
     if (!left_used.empty() && left_used[i]) continue;
     const Eigen::Vector2d& xl = left.undistorted[i];
     const Eigen::Vector3d ray = K_left_inv_ * Eigen::Vector3d(xl.x(), xl.y(), 1.0);
-    // Segment of the epipolar line from the image of the point at infinity (zero
-    // disparity) to the image of the point at min_depth (positive disparity side).
+    // Segment of the epipolar line from the image of the point at max_depth (or infinity:
+    // zero disparity) to the image of the point at min_depth (positive disparity side):
+    // nothing outside the depths the filter accepts is searched (plausible disparities only).
     Eigen::Vector2d x_inf, x_near;
-    if (!projectRight(K_right_, T_ropt_lopt_.linear() * ray, &x_inf)) continue;
+    const bool far_finite = std::isfinite(max_depth_);
+    if (!(far_finite ? projectRight(K_right_, T_ropt_lopt_ * (max_depth_ * ray), &x_inf)
+                     : projectRight(K_right_, T_ropt_lopt_.linear() * ray, &x_inf))) {
+      continue;
+    }
     double near_depth = min_depth_;
     bool near_ok = projectRight(K_right_, T_ropt_lopt_ * (near_depth * ray), &x_near);
     for (int k = 0; k < 8 && !near_ok; ++k) {
@@ -101,17 +126,19 @@ std::vector<StereoMatch> EpipolarMatcher::match(const FeatureSet& left, const Fe
     double var_inf = pixel_var, var_near = pixel_var;
     for (int j = 0; j < 6; ++j) {
       Eigen::Vector2d p;
-      if (projectRight(K_right_, T_sigma_[j].linear() * ray, &p)) {
+      if (far_finite ? projectRight(K_right_, T_sigma_[j] * (max_depth_ * ray), &p)
+                     : projectRight(K_right_, T_sigma_[j].linear() * ray, &p)) {
         var_inf += std::pow(dir.dot(p - x_inf), 2);
       }
       if (projectRight(K_right_, T_sigma_[j] * (near_depth * ray), &p)) {
         var_near += std::pow(dir.dot(p - x_near), 2);
       }
     }
+    const Lines line = lines(xl);
     const double margin_inf = std::min(config_.band_sigmas * std::sqrt(var_inf), config_.max_band);
     const double margin_near =
         std::min(config_.band_sigmas * std::sqrt(var_near), config_.max_band);
-    const double band = std::max(bandHalfWidth(xl, x_inf), bandHalfWidth(xl, x_near));
+    const double band = std::max(bandHalfWidth(line, x_inf), bandHalfWidth(line, x_near));
     const double t_min = -std::max(margin_inf, config_.min_band);
     const double t_max = length + std::max(margin_near, config_.min_band);
 
@@ -130,48 +157,59 @@ std::vector<StereoMatch> EpipolarMatcher::match(const FeatureSet& left, const Fe
       right.undistorted_grid.query(lo, hi, &candidates);
     }
 
-    const Eigen::Vector3d line = epipolarLine(F_, xl);  // eq. 6
-    double best = inf, second = inf;
-    int best_j = -1;
-    double best_line = 0.0, best_band = 0.0;
+    StereoMatch& best = best_of_left[i];
+    best.descriptor_distance = inf;
+    double& second = second_of_left[i];
     for (int j : candidates) {
-      if (stamp[static_cast<size_t>(j)] == static_cast<int>(i)) continue;  // chunk overlap
-      stamp[static_cast<size_t>(j)] = static_cast<int>(i);
-      if (!right_used.empty() && right_used[static_cast<size_t>(j)]) continue;
-      const Eigen::Vector2d& xr = right.undistorted[static_cast<size_t>(j)];
+      const size_t sj = static_cast<size_t>(j);
+      if (stamp[sj] == static_cast<int>(i)) continue;  // chunk overlap
+      stamp[sj] = static_cast<int>(i);
+      if (!right_used.empty() && right_used[sj]) continue;
+      const Eigen::Vector2d& xr = right.undistorted[sj];
       const double t = dir.dot(xr - x_inf);
       if (t < t_min || t > t_max) continue;  // negative disparity or closer than min_depth
-      const double d = line.dot(Eigen::Vector3d(xr.x(), xr.y(), 1.0));
-      const double half = bandHalfWidth(xl, xr);
+      const double d = line.nominal.dot(Eigen::Vector3d(xr.x(), xr.y(), 1.0));
+      if (std::abs(d) > config_.max_band) continue;
+      const double half = bandHalfWidth(line, xr);
       if (std::abs(d) > half) continue;
-      const double dist = right.distance(j, left.descriptors.row(static_cast<int>(i)));
-      if (dist < best) {
-        second = best;
-        best = dist;
-        best_j = j;
-        best_line = d;
-        best_band = half;
+      const double dist = left.distance(static_cast<int>(i), right, j);
+      if (dist < best.descriptor_distance) {
+        second = best.descriptor_distance;
+        best.left = static_cast<int>(i);
+        best.right = j;
+        best.descriptor_distance = dist;
+        best.line_distance = d;
+        best.band = half;
       } else if (dist < second) {
         second = dist;
       }
-    }
-    if (best_j < 0 || best > config_.max_descriptor_distance) continue;
-    if (second < inf && best >= config_.ratio * second) continue;  // Lowe's ratio test
-    StereoMatch& slot = best_for_right[static_cast<size_t>(best_j)];
-    if (slot.left < 0 || best < slot.descriptor_distance) {
-      slot.left = static_cast<int>(i);
-      slot.right = best_j;
-      slot.descriptor_distance = best;
-      slot.line_distance = best_line;
-      slot.band = best_band;
+      if (dist < right_best_distance[sj]) {
+        right_second[sj] = right_best_distance[sj];
+        right_best_distance[sj] = dist;
+        right_best[sj] = static_cast<int>(i);
+      } else if (dist < right_second[sj]) {
+        right_second[sj] = dist;
+      }
     }
   }
+  // Accept a proposal when it is distinctive from both sides: within the distance bound,
+  // passing Lowe's ratio test among the left keypoint's candidates and among the right
+  // keypoint's candidates (the left keypoints whose bands hold it), and mutual (the right
+  // keypoint's best left keypoint is this one), which also makes the matches one-to-one.
   std::vector<StereoMatch> matches;
-  for (const StereoMatch& m : best_for_right) {
-    if (m.left >= 0) matches.push_back(m);
+  for (size_t i = 0; i < left.size(); ++i) {
+    StereoMatch m = best_of_left[i];
+    if (m.left < 0 || m.descriptor_distance > config_.max_descriptor_distance) continue;
+    const double second = second_of_left[i];
+    if (second < inf && m.descriptor_distance >= config_.ratio * second) continue;
+    const size_t sj = static_cast<size_t>(m.right);
+    if (right_best[sj] != static_cast<int>(i)) continue;
+    if (right_second[sj] < inf && m.descriptor_distance >= config_.ratio * right_second[sj]) {
+      continue;
+    }
+    m.second_distance = std::min(second, right_second[sj]);
+    matches.push_back(m);
   }
-  std::sort(matches.begin(), matches.end(),
-            [](const StereoMatch& a, const StereoMatch& b) { return a.left < b.left; });
   return matches;
 }
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <stdexcept>
 
 #include <opencv2/features2d.hpp>
@@ -104,11 +106,26 @@ void SpatialGrid::query(const Eigen::Vector2d& min, const Eigen::Vector2d& max,
   }
 }
 
-double FeatureSet::distance(int i, const cv::Mat& descriptor) const {
-  const cv::Mat row = descriptors.row(i);
-  if (binary) {
-    return cv::norm(row, descriptor, cv::NORM_HAMMING) / (8.0 * descriptors.cols);
+double hammingDistance(const unsigned char* a, const unsigned char* b, int bytes) {
+  int bits = 0;
+  int k = 0;
+  for (; k + 8 <= bytes; k += 8) {
+    std::uint64_t x, y;
+    std::memcpy(&x, a + k, 8);
+    std::memcpy(&y, b + k, 8);
+    bits += __builtin_popcountll(x ^ y);
   }
+  for (; k < bytes; ++k) bits += __builtin_popcount(static_cast<unsigned>(a[k] ^ b[k]));
+  return static_cast<double>(bits);
+}
+
+double FeatureSet::distance(int i, const cv::Mat& descriptor) const {
+  if (binary) {
+    return hammingDistance(descriptors.ptr<unsigned char>(i), descriptor.ptr<unsigned char>(0),
+                           descriptors.cols) /
+           (8.0 * descriptors.cols);
+  }
+  const cv::Mat row = descriptors.row(i);
   const double n2 = static_cast<double>(descriptor_norms[static_cast<size_t>(i)]) *
                         descriptor_norms[static_cast<size_t>(i)] +
                     cv::norm(descriptor, cv::NORM_L2SQR);
@@ -116,8 +133,17 @@ double FeatureSet::distance(int i, const cv::Mat& descriptor) const {
   return cv::norm(row, descriptor, cv::NORM_L2) / std::sqrt(n2);
 }
 
+double FeatureSet::distance(int i, const FeatureSet& other, int j) const {
+  if (binary && other.binary) {
+    return hammingDistance(descriptors.ptr<unsigned char>(i),
+                           other.descriptors.ptr<unsigned char>(j), descriptors.cols) /
+           (8.0 * descriptors.cols);
+  }
+  return distance(i, other.descriptors.row(j));
+}
+
 FeatureDetector::FeatureDetector(const FrontEndConfig& config) : config_(config) {
-  const int candidates = 3 * config.max_features;
+  const int candidates = 3 * config.max_features / 2;
   if (config.detector == "ORB") {
     auto orb =
         cv::ORB::create(candidates, static_cast<float>(config.orb_scale_factor), config.orb_levels,

@@ -36,6 +36,15 @@ std::vector<std::string> FrontEndConfig::validate() const {
   checkRange(&p, "pixel_sigma", pixel_sigma, 0.0, 10.0);
   checkRange(&p, "max_descriptor_distance", max_descriptor_distance, 0.0, 1.0, true);
   checkRange(&p, "ratio", ratio, 0.0, 1.0, true);
+  checkRange(&p, "patch_half_size", patch_half_size, 1, 15);
+  checkRange(&p, "max_refinement_shift", max_refinement_shift, 0.0, 20.0, true);
+  checkRange(&p, "max_temporal_shift", max_temporal_shift, 0.0, 20.0, true);
+  checkRange(&p, "min_search_ncc", min_search_ncc, -1.0, 1.0);
+  checkRange(&p, "max_forward_backward", max_forward_backward, 0.0, 10.0, true);
+  checkRange(&p, "discontinuity_search", discontinuity_search, 0, 20);
+  checkRange(&p, "min_patch_ncc", min_patch_ncc, -1.0, 1.0);
+  checkRange(&p, "min_patch_eigen_ratio", min_patch_eigen_ratio, 0.0, 1.0);
+  checkRange(&p, "refined_pixel_sigma", refined_pixel_sigma, 0.0, 10.0, true);
   checkRange(&p, "bucket_cols", bucket_cols, 1, 64);
   checkRange(&p, "bucket_rows", bucket_rows, 1, 64);
   checkRange(&p, "max_new_points_per_frame", max_new_points_per_frame, 0, 10000);
@@ -45,6 +54,8 @@ std::vector<std::string> FrontEndConfig::validate() const {
   checkRange(&p, "min_track_window", min_track_window, 0.5, 100.0);
   checkRange(&p, "max_track_window", max_track_window, min_track_window, 500.0);
   checkRange(&p, "max_track_descriptor_distance", max_track_descriptor_distance, 0.0, 1.0, true);
+  checkRange(&p, "track_ratio", track_ratio, 0.0, 1.0, true);
+  checkRange(&p, "track_gate_chi2_2dof", track_gate_chi2_2dof, 0.0, 1000.0, true);
   checkRange(&p, "min_image_size", min_image_size, 8, 10000);
   checkRange(&p, "min_contrast", min_contrast, 0.0, 100.0);
   return p;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/LU>
+
 namespace osc {
 namespace {
 
@@ -35,32 +37,32 @@ void window(const CameraModel& camera, const Eigen::Vector2d& z, const Eigen::Ma
   }
 }
 
-struct Candidate {
-  int index = -1;
-  double distance = std::numeric_limits<double>::infinity();
-};
-
-Candidate bestInWindow(const FeatureSet& set, const Eigen::Vector2d& center,
-                       const Eigen::Vector2d& half, const cv::Mat& descriptor,
-                       std::vector<int>* scratch, const std::function<bool(int)>& accept = {}) {
-  scratch->clear();
-  set.raw_grid.query(center - half, center + half, scratch);
-  Candidate best;
-  for (int j : *scratch) {
-    if (accept && !accept(j)) continue;
-    const double d = set.distance(j, descriptor);
-    if (d < best.distance) best = {j, d};
-  }
-  return best;
+/// Squared Mahalanobis distance of a 2-vector under covariance S (infinite if singular).
+double mahalanobis2(const Eigen::Vector2d& e, const Eigen::Matrix2d& S) {
+  const double det = S.determinant();
+  if (!(det > 0.0)) return std::numeric_limits<double>::infinity();
+  return e.dot(S.inverse() * e);
 }
 
 }  // namespace
 
 PointTracker::PointTracker(const FrontEndConfig& config) : config_(config) {}
 
-void PointTracker::add(PointId id, const cv::Mat& left_descriptor,
-                       const cv::Mat& right_descriptor) {
-  tracks_[id] = Track{left_descriptor.clone(), right_descriptor.clone()};
+void PointTracker::add(PointId id, const cv::Mat& left_descriptor, const cv::Mat& right_descriptor,
+                       const Eigen::Vector2d& left_pixel) {
+  tracks_[id] = Track{left_descriptor.clone(), right_descriptor.clone(), left_pixel};
+}
+
+bool PointTracker::leftPixel(PointId id, Eigen::Vector2d* pixel) const {
+  const auto it = tracks_.find(id);
+  if (it == tracks_.end()) return false;
+  *pixel = it->second.left_pixel;
+  return true;
+}
+
+void PointTracker::setLeftPixel(PointId id, const Eigen::Vector2d& pixel) {
+  const auto it = tracks_.find(id);
+  if (it != tracks_.end()) it->second.left_pixel = pixel;
 }
 
 void PointTracker::remove(PointId id) { tracks_.erase(id); }
@@ -74,6 +76,8 @@ std::vector<TrackWindow> PointTracker::windows(const std::vector<PredictedObserv
     if (!has(p.id) || !p.z.allFinite() || !p.S.allFinite()) continue;
     TrackWindow w;
     w.id = p.id;
+    w.z = p.z;
+    w.S = p.S;
     window(left, p.z.head<2>(), p.S.topLeftCorner<2, 2>(), config_, &w.left_center, &w.left_half);
     window(right, p.z.tail<2>(), p.S.bottomRightCorner<2, 2>(), config_, &w.right_center,
            &w.right_half);
@@ -92,20 +96,65 @@ std::vector<TrackMatch> PointTracker::track(const std::vector<TrackWindow>& wind
     TrackMatch match;
     double cost;
   };
+  const double inf = std::numeric_limits<double>::infinity();
   std::vector<Proposal> proposals;
   std::vector<int> scratch;
   for (const TrackWindow& w : windows) {
     const auto it = tracks_.find(w.id);
     if (it == tracks_.end() || left.size() == 0 || right.size() == 0) continue;
-    const Candidate l =
-        bestInWindow(left, w.left_center, w.left_half, it->second.left_descriptor, &scratch);
-    if (l.index < 0 || l.distance > config_.max_track_descriptor_distance) continue;
-    std::function<bool(int)> accept;
-    if (consistent) accept = [&](int j) { return consistent(l.index, j); };
-    const Candidate r = bestInWindow(right, w.right_center, w.right_half,
-                                     it->second.right_descriptor, &scratch, accept);
-    if (r.index < 0 || r.distance > config_.max_track_descriptor_distance) continue;
-    proposals.push_back({{w.id, l.index, r.index}, l.distance + r.distance});
+    const Track& t = it->second;
+    // Left image: the keypoint in the window (and inside the Mahalanobis gate of the
+    // predicted left pixel) closest to the stored descriptor, and the runner-up.
+    scratch.clear();
+    left.raw_grid.query(w.left_center - w.left_half, w.left_center + w.left_half, &scratch);
+    const Eigen::Matrix2d S_ll = w.S.topLeftCorner<2, 2>();
+    int l = -1;
+    double l_best = inf, l_second = inf;
+    for (int j : scratch) {
+      const Eigen::Vector2d e = left.undistorted[static_cast<size_t>(j)] - w.z.head<2>();
+      if (mahalanobis2(e, S_ll) > config_.track_gate_chi2_2dof) continue;
+      const double d = left.distance(j, t.left_descriptor);
+      if (d < l_best) {
+        l_second = l_best;
+        l_best = d;
+        l = j;
+      } else if (d < l_second) {
+        l_second = d;
+      }
+    }
+    if (l < 0 || l_best > config_.max_track_descriptor_distance) continue;
+    if (l_second < inf && l_best >= config_.track_ratio * l_second) continue;
+    // Right image: the same within the window, the epipolar band of the chosen left
+    // keypoint and the gate of the right pixel conditioned on the left one (4-dof
+    // innovation).
+    const Eigen::Vector2d el = left.undistorted[static_cast<size_t>(l)] - w.z.head<2>();
+    const Eigen::Matrix2d S_rr = w.S.bottomRightCorner<2, 2>();
+    const Eigen::Matrix2d S_rl = w.S.bottomLeftCorner<2, 2>();
+    const Eigen::Matrix2d gain = S_rl * S_ll.inverse();
+    const Eigen::Vector2d r_mean = w.z.tail<2>() + gain * el;
+    const Eigen::Matrix2d r_cov = S_rr - gain * S_rl.transpose();
+    scratch.clear();
+    right.raw_grid.query(w.right_center - w.right_half, w.right_center + w.right_half, &scratch);
+    int r = -1;
+    double r_best = inf, r_second = inf;
+    for (int j : scratch) {
+      if (consistent && !consistent(l, j)) continue;
+      const Eigen::Vector2d e = right.undistorted[static_cast<size_t>(j)] - r_mean;
+      if (mahalanobis2(e, r_cov) > config_.track_gate_chi2_2dof) continue;
+      const double d = right.distance(j, t.right_descriptor);
+      if (d < r_best) {
+        r_second = r_best;
+        r_best = d;
+        r = j;
+      } else if (d < r_second) {
+        r_second = d;
+      }
+    }
+    if (r < 0 || r_best > config_.max_track_descriptor_distance) continue;
+    if (r_second < inf && r_best >= config_.track_ratio * r_second) continue;
+    // The pair must also be a stereo match of this frame.
+    if (left.distance(l, right, r) > config_.max_descriptor_distance) continue;
+    proposals.push_back({{w.id, l, r}, l_best + r_best});
   }
   // One keypoint per track: the better proposals first.
   std::sort(proposals.begin(), proposals.end(),

@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_set>
 
+#include <Eigen/LU>
 #include <opencv2/imgproc.hpp>
 
 #include "online_stereo_calibration/core/frontend/bucketing.h"
+#include "online_stereo_calibration/core/frontend/patch_alignment.h"
 #include "online_stereo_calibration/core/geometry/stereo_geometry.h"
 
 namespace osc {
@@ -40,7 +43,7 @@ StereoFrontEnd::StereoFrontEnd(const FrontEndConfig& config, const FilterConfig&
       left_camera_(left),
       right_camera_(right),
       detector_(config_),
-      matcher_(config_, filter_config.min_point_depth),
+      matcher_(config_, filter_config.min_point_depth, filter_config.max_point_depth),
       tracker_(config_) {}
 
 std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
@@ -49,12 +52,16 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
                                                        const CalibrationFilter& filter,
                                                        FrontEndStatistics* statistics) {
   FrontEndStatistics stats;
+  // The previous left image, kept as a copy (the caller may reuse its buffers).
+  std::swap(previous_left_, current_left_);
+  left_mono.copyTo(current_left_);
   last_left_ = left_mono;
   last_right_ = right_mono;
   last_tracked_.clear();
   last_new_.clear();
   last_matches_.clear();
   last_windows_.clear();
+  last_bands_.clear();
   pending_.clear();
 
   const FeatureSet left = detector_.detect(left_mono, left_camera_);
@@ -67,11 +74,51 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   const Matrix12d& P = filter.covariance();
   matcher_.setGeometry(left_camera_.K(), right_camera_.K(), filter.extrinsics().T_caml_camr,
                        P.bottomRightCorner<6, 6>());
-  const Eigen::Matrix3d& F = matcher_.fundamental();
   auto on_band = [&](int l, int r) {
     const Eigen::Vector2d& ul = left.undistorted[static_cast<size_t>(l)];
     const Eigen::Vector2d& ur = right.undistorted[static_cast<size_t>(r)];
-    return std::abs(epipolarLine(F, ul).dot(ur.homogeneous())) <= matcher_.bandHalfWidth(ul, ur);
+    const EpipolarMatcher::Lines lines = matcher_.lines(ul);
+    return std::abs(lines.nominal.dot(ur.homogeneous())) <= matcher_.bandHalfWidth(lines, ur);
+  };
+  // Sub-pixel right pixel of a pair: the left keypoint's patch aligned into the right image;
+  // false if the alignment is unreliable (edge, occlusion, different content) or leaves the
+  // epipolar band.
+  PatchAlignmentConfig alignment;
+  alignment.half_size = config_.patch_half_size;
+  alignment.max_shift = config_.max_refinement_shift;
+  alignment.min_ncc = config_.min_patch_ncc;
+  alignment.min_eigenvalue = config_.min_patch_eigen_ratio;
+  auto refine = [&](const Eigen::Vector2d& left_raw, const Eigen::Vector2d& left_und,
+                    const Eigen::Vector2d& right_guess, Eigen::Vector2d* right_raw,
+                    Eigen::Vector2d* right_und, double max_shift = 0.0) {
+    PatchAlignmentConfig c = alignment;
+    if (max_shift > 0.0) c.max_shift = max_shift;
+    const PatchAlignment a = alignPatch(left_mono, left_raw, right_mono, right_guess, c);
+    if (!a.ok) return false;
+    *right_raw = a.position;
+    *right_und = right_camera_.undistortPixel(a.position);
+    const EpipolarMatcher::Lines lines = matcher_.lines(left_und);
+    if (std::abs(lines.nominal.dot(right_und->homogeneous())) >
+        matcher_.bandHalfWidth(lines, *right_und, config_.refined_pixel_sigma)) {
+      return false;
+    }
+    return true;
+  };
+  // Pairs handed to the filter (tracked and new) are also checked for a depth discontinuity
+  // across their patch (costly, so not every match is).
+  auto continuous = [&](const Eigen::Vector2d& left_raw, const Eigen::Vector2d& left_und,
+                        const Eigen::Vector2d& right_raw, const Eigen::Vector2d& right_und) {
+    if (config_.discontinuity_search <= 0) return true;
+    // The epipolar direction at the right pixel (raw image, along the line).
+    const Eigen::Vector3d line = matcher_.lines(left_und).nominal;
+    const Eigen::Vector2d ahead = right_camera_.normalizedToPixel(
+        (right_camera_.K().inverse() *
+         (right_und + Eigen::Vector2d(line.y(), -line.x())).homogeneous())
+            .head<2>());
+    const Eigen::Vector2d dir = ahead - right_raw;
+    return !(dir.norm() > 1e-9 && straddlesDepthDiscontinuity(
+                                      left_mono, left_raw, right_mono, right_raw, dir.normalized(),
+                                      config_.patch_half_size, config_.discontinuity_search));
   };
 
   // 1. Tracking (Sec. II-C): windows from the filter's predictions and S.
@@ -81,21 +128,111 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
         tracker_.windows(filter.predictObservations(motion), left_camera_, right_camera_);
     const std::vector<TrackMatch> found =
         tracker_.track(last_windows_, left, right, &left_used, &right_used, on_band);
+    // Sub-pixel: the point's patch in the previous left image is aligned into this one from
+    // the keypoint found (so the track stays on the same surface point instead of following
+    // the detector's pixel-grid jitter), then into the right image.
+    PatchAlignmentConfig temporal = alignment;
+    temporal.max_shift = config_.max_temporal_shift;
     for (const TrackMatch& m : found) {
-      observations.push_back(observation(m.id, left.raw[static_cast<size_t>(m.left)],
-                                         right.raw[static_cast<size_t>(m.right)]));
+      Eigen::Vector2d left_raw = left.raw[static_cast<size_t>(m.left)];
+      Eigen::Vector2d left_und = left.undistorted[static_cast<size_t>(m.left)];
+      Eigen::Vector2d previous;
+      if (!previous_left_.empty() && tracker_.leftPixel(m.id, &previous)) {
+        const PatchAlignment a =
+            alignPatch(previous_left_, previous, left_mono, left_raw, temporal);
+        if (!a.ok) continue;
+        left_raw = a.position;
+        left_und = left_camera_.undistortPixel(left_raw);
+      }
+      Eigen::Vector2d right_raw, right_und;
+      if (!refine(left_raw, left_und, right.raw[static_cast<size_t>(m.right)], &right_raw,
+                  &right_und) ||
+          !continuous(left_raw, left_und, right_raw, right_und)) {
+        continue;
+      }
+      tracker_.setLeftPixel(m.id, left_raw);
+      observations.push_back(observation(m.id, left_raw, right_raw));
+    }
+  }
+  // Tracks whose keypoint was not detected again (or not confirmed): the point's patch of
+  // the previous left image is searched directly around its predicted pixel (Lucas-Kanade
+  // from the prediction, Sec. II-C's window and the filter's S as the gate), then in the
+  // right image around the right prediction moved by the left innovation.
+  if (config_.search_lost_tracks && !previous_left_.empty()) {
+    std::unordered_set<PointId> observed;
+    for (const StereoObservation& o : observations) observed.insert(o.id);
+    for (const TrackWindow& w : last_windows_) {
+      if (observed.count(w.id)) continue;
+      Eigen::Vector2d previous;
+      if (!tracker_.leftPixel(w.id, &previous)) continue;
+      PatchAlignmentConfig search = alignment;
+      search.max_shift = w.left_half.maxCoeff();
+      search.min_ncc = config_.min_search_ncc;
+      const PatchAlignment a =
+          alignPatch(previous_left_, previous, left_mono, w.left_center, search);
+      if (!a.ok) continue;
+      // Forward-backward: the found patch aligned back must land where the point was.
+      const PatchAlignment back =
+          alignPatch(left_mono, a.position, previous_left_, previous, search);
+      if (!back.ok || (back.position - previous).norm() > config_.max_forward_backward) continue;
+      const Eigen::Vector2d left_raw = a.position;
+      const Eigen::Vector2d left_und = left_camera_.undistortPixel(left_raw);
+      const Eigen::Vector2d el = left_und - w.z.head<2>();
+      const Eigen::Matrix2d S_ll = w.S.topLeftCorner<2, 2>();
+      if (!(S_ll.determinant() > 0.0) ||
+          el.dot(S_ll.inverse() * el) > config_.track_gate_chi2_2dof) {
+        continue;
+      }
+      // The right prediction conditioned on the left pixel found (S's cross terms).
+      const Eigen::Matrix2d S_rl = w.S.bottomLeftCorner<2, 2>();
+      const Eigen::Matrix2d gain = S_rl * S_ll.inverse();
+      const Eigen::Vector2d r_mean = w.z.tail<2>() + gain * el;
+      const Eigen::Matrix2d r_cov = w.S.bottomRightCorner<2, 2>() - gain * S_rl.transpose();
+      const Eigen::Vector2d r_guess = right_camera_.normalizedToPixel(
+          (right_camera_.K().inverse() * r_mean.homogeneous()).head<2>());
+      Eigen::Vector2d right_raw, right_und;
+      if (!refine(left_raw, left_und, r_guess, &right_raw, &right_und) ||
+          !continuous(left_raw, left_und, right_raw, right_und)) {
+        continue;
+      }
+      const Eigen::Vector2d er = right_und - r_mean;
+      if (!(r_cov.determinant() > 0.0) ||
+          er.dot(r_cov.inverse() * er) > config_.track_gate_chi2_2dof) {
+        continue;
+      }
+      tracker_.setLeftPixel(w.id, left_raw);
+      observations.push_back(observation(w.id, left_raw, right_raw));
     }
   }
   last_tracked_ = observations;
   stats.tracked = static_cast<int>(observations.size());
   stats.track_failures = static_cast<int>(tracker_.size()) - stats.tracked;
 
-  // 2. New points: epipolar-guided matching with the current x_camr (eq. 5-6).
-  const std::vector<StereoMatch> matches = matcher_.match(left, right, left_used, right_used);
-  stats.stereo_matches = static_cast<int>(matches.size());
+  // 2. New points: epipolar-guided matching with the current x_camr (eq. 5-6), only of the
+  // left keypoints that could become one (not in a bucket holding a tracked point: the
+  // bucketing below would refuse them) and only if the state has room.
+  const int room = filter_config_.max_points - static_cast<int>(observations.size());
+  const int max_new = std::max(0, std::min(config_.max_new_points_per_frame, room));
+  std::vector<char> left_excluded = left_used;
+  {
+    const int cols = config_.bucket_cols, rows = config_.bucket_rows;
+    auto cellOf = [&](const Eigen::Vector2d& p) {
+      const int c =
+          std::clamp(static_cast<int>(std::floor(p.x() * cols / left_mono.cols)), 0, cols - 1);
+      const int r =
+          std::clamp(static_cast<int>(std::floor(p.y() * rows / left_mono.rows)), 0, rows - 1);
+      return static_cast<size_t>(r * cols + c);
+    };
+    std::vector<char> blocked(static_cast<size_t>(cols * rows), 0);
+    for (const StereoObservation& o : observations) blocked[cellOf(o.left_pixel)] = 1;
+    for (size_t i = 0; i < left.size(); ++i) {
+      if (max_new == 0 || blocked[cellOf(left.raw[i])]) left_excluded[i] = 1;
+    }
+  }
+  const std::vector<StereoMatch> matches = matcher_.match(left, right, left_excluded, right_used);
 
   // 3. Reject what cannot make a good point: behind, too close / far, too little parallax,
-  // or where a tracked point already is.
+  // not confirmed by the sub-pixel alignment, or where a tracked point already is.
   const Eigen::Isometry3d T_lopt_ropt = filter.extrinsics().leftToRightOptical();
   const Eigen::Matrix3d Kl_inv = left_camera_.K().inverse(), Kr_inv = right_camera_.K().inverse();
   std::vector<Eigen::Vector2d> tracked_pixels;
@@ -103,26 +240,29 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   SpatialGrid tracked_grid;
   tracked_grid.build(tracked_pixels, left_mono.cols, left_mono.rows, 32.0);
   const double min_parallax = config_.min_parallax_deg * M_PI / 180.0;
-  std::vector<Eigen::Vector2d> positions;
+  auto plausible = [&](const Eigen::Vector2d& ul, const Eigen::Vector2d& ur) {
+    const auto tri =
+        triangulateMidpoint(Kl_inv * Eigen::Vector3d(ul.x(), ul.y(), 1.0),
+                            Kr_inv * Eigen::Vector3d(ur.x(), ur.y(), 1.0), T_lopt_ropt);
+    if (!tri) return false;
+    const double depth = tri->point_left.z();
+    return depth >= filter_config_.min_point_depth && depth <= filter_config_.max_point_depth &&
+           tri->parallax >= min_parallax;
+  };
+  std::vector<Eigen::Vector2d> positions, right_positions;
   std::vector<double> costs;
   std::vector<int> usable;
   std::vector<int> near;
   for (size_t k = 0; k < matches.size(); ++k) {
     const StereoMatch& m = matches[k];
     const Eigen::Vector2d& pl = left.raw[static_cast<size_t>(m.left)];
-    const Eigen::Vector2d& pr = right.raw[static_cast<size_t>(m.right)];
-    last_matches_.push_back(observation(0, pl, pr));
     const Eigen::Vector2d& ul = left.undistorted[static_cast<size_t>(m.left)];
-    const Eigen::Vector2d& ur = right.undistorted[static_cast<size_t>(m.right)];
-    const auto tri =
-        triangulateMidpoint(Kl_inv * Eigen::Vector3d(ul.x(), ul.y(), 1.0),
-                            Kr_inv * Eigen::Vector3d(ur.x(), ur.y(), 1.0), T_lopt_ropt);
-    if (!tri) continue;
-    const double depth = tri->point_left.z();
-    if (depth < filter_config_.min_point_depth || depth > filter_config_.max_point_depth ||
-        tri->parallax < min_parallax) {
+    if (!plausible(ul, right.undistorted[static_cast<size_t>(m.right)])) continue;
+    Eigen::Vector2d pr, ur;
+    if (!refine(pl, ul, right.raw[static_cast<size_t>(m.right)], &pr, &ur) || !plausible(ul, ur)) {
       continue;
     }
+    last_matches_.push_back(observation(0, pl, pr));
     near.clear();
     const Eigen::Vector2d r = Eigen::Vector2d::Constant(config_.min_distance_to_track);
     tracked_grid.query(pl - r, pl + r, &near);
@@ -134,27 +274,58 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     if (too_close) continue;
     usable.push_back(static_cast<int>(k));
     positions.push_back(pl);
+    right_positions.push_back(pr);
     costs.push_back(m.descriptor_distance);
   }
+  stats.stereo_matches = static_cast<int>(last_matches_.size());
 
   // 4. Bucketing and the caps: per frame and in the state (FilterConfig::max_points).
-  const int room = filter_config_.max_points - static_cast<int>(observations.size());
-  const int max_new = std::max(0, std::min(config_.max_new_points_per_frame, room));
   const std::vector<int> kept =
       selectByBuckets(positions, costs, tracked_pixels, left_mono.cols, left_mono.rows,
                       config_.bucket_cols, config_.bucket_rows, max_new);
   for (int u : kept) {
     const StereoMatch& m = matches[static_cast<size_t>(usable[static_cast<size_t>(u)])];
+    if (!continuous(positions[static_cast<size_t>(u)],
+                    left.undistorted[static_cast<size_t>(m.left)],
+                    right_positions[static_cast<size_t>(u)],
+                    right_camera_.undistortPixel(right_positions[static_cast<size_t>(u)]))) {
+      continue;
+    }
     const PointId id = next_id_++;
-    observations.push_back(observation(id, left.raw[static_cast<size_t>(m.left)],
-                                       right.raw[static_cast<size_t>(m.right)]));
+    observations.push_back(observation(id, positions[static_cast<size_t>(u)],
+                                       right_positions[static_cast<size_t>(u)]));
     last_new_.push_back(observations.back());
-    pending_.push_back(
-        {id, left.descriptors.row(m.left).clone(), right.descriptors.row(m.right).clone()});
+    last_bands_.push_back(
+        bandPolylines(left.undistorted[static_cast<size_t>(m.left)],
+                      right_camera_.undistortPixel(right_positions[static_cast<size_t>(u)])));
+    pending_.push_back({id, left.descriptors.row(m.left).clone(),
+                        right.descriptors.row(m.right).clone(), positions[static_cast<size_t>(u)]});
   }
-  stats.new_candidates = static_cast<int>(kept.size());
+  stats.new_candidates = static_cast<int>(last_new_.size());
   if (statistics) *statistics = stats;
   return observations;
+}
+
+StereoFrontEnd::EpipolarBand StereoFrontEnd::bandPolylines(const Eigen::Vector2d& left_und,
+                                                           const Eigen::Vector2d& right_und) const {
+  // The band around the epipolar line of the left pixel near the match (eq. 5-6), +-60 px
+  // along the line, in raw right pixels (the line is curved there under distortion).
+  EpipolarBand band;
+  const EpipolarMatcher::Lines lines = matcher_.lines(left_und);
+  const Eigen::Vector3d& l = lines.nominal;
+  const double half = matcher_.bandHalfWidth(lines, right_und);
+  const Eigen::Vector2d normal(l.x(), l.y()), along(l.y(), -l.x());
+  const Eigen::Vector2d foot = right_und - l.dot(right_und.homogeneous()) * normal;
+  const Eigen::Matrix3d K_inv = right_camera_.K().inverse();
+  for (double t = -60.0; t <= 60.0; t += 10.0) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2d u = foot + t * along + (k - 1) * half * normal;
+      const Eigen::Vector2d raw =
+          right_camera_.normalizedToPixel((K_inv * u.homogeneous()).head<2>());
+      band.lines[k].emplace_back(static_cast<float>(raw.x()), static_cast<float>(raw.y()));
+    }
+  }
+  return band;
 }
 
 void StereoFrontEnd::commit(const FrameReport& report, const CalibrationFilter& filter) {
@@ -163,7 +334,9 @@ void StereoFrontEnd::commit(const FrameReport& report, const CalibrationFilter& 
     if (!filter.hasPoint(o.id)) tracker_.remove(o.id);
   }
   for (const Pending& p : pending_) {
-    if (filter.hasPoint(p.id)) tracker_.add(p.id, p.left_descriptor, p.right_descriptor);
+    if (filter.hasPoint(p.id)) {
+      tracker_.add(p.id, p.left_descriptor, p.right_descriptor, p.left_pixel);
+    }
   }
   pending_.clear();
 }
@@ -171,6 +344,8 @@ void StereoFrontEnd::commit(const FrameReport& report, const CalibrationFilter& 
 void StereoFrontEnd::reset() {
   tracker_.clear();
   pending_.clear();
+  previous_left_.release();
+  current_left_.release();
 }
 
 cv::Mat StereoFrontEnd::debugImage() const {
@@ -197,6 +372,18 @@ cv::Mat StereoFrontEnd::debugImage() const {
                   yellow, 1);
     cv::rectangle(canvas, pt(win.right_center - win.right_half, w),
                   pt(win.right_center + win.right_half, w), cyan, 1);
+  }
+  // Epipolar bands (eq. 5-6) of the new points in the right image: centre line and edges.
+  const cv::Scalar magenta(200, 0, 200);
+  for (const EpipolarBand& band : last_bands_) {
+    for (int k = 0; k < 3; ++k) {
+      std::vector<cv::Point> poly;
+      for (const cv::Point2f& p : band.lines[k]) {
+        poly.emplace_back(static_cast<int>(std::lround(p.x + w)),
+                          static_cast<int>(std::lround(p.y)));
+      }
+      cv::polylines(canvas, poly, false, magenta, 1, k == 1 ? cv::LINE_8 : cv::LINE_4);
+    }
   }
   for (const StereoObservation& o : last_new_) {
     cv::circle(canvas, pt(o.left_pixel), 4, blue, 2);

@@ -4,6 +4,7 @@
 /// positive disparity, then descriptor threshold, ratio test and one-to-one.
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -22,13 +23,18 @@ struct StereoMatch {
   double descriptor_distance = 0.0;  ///< normalised, see FrontEndConfig
   double line_distance = 0.0;        ///< signed distance (px) from the epipolar line
   double band = 0.0;                 ///< half-width (px) of the band it was accepted in
+  /// The next best normalised distance seen from either keypoint (infinity if none).
+  double second_distance = 0.0;
 };
 
 /// Matches left keypoints to right keypoints along their epipolar lines.
 class EpipolarMatcher {
  public:
-  /// Depths (m, along the left ray) bounding the search segment on the near side.
-  EpipolarMatcher(const FrontEndConfig& config, double min_depth);
+  /// Depths (m, along the left ray) bounding the search segment: from the image of the
+  /// point at max_depth (infinity: the zero-disparity end) to that at min_depth, widened by
+  /// the uncertainty of x_camr.
+  EpipolarMatcher(const FrontEndConfig& config, double min_depth,
+                  double max_depth = std::numeric_limits<double>::infinity());
 
   /// Sets the geometry of this frame: intrinsics, the current x_camr (T_caml_camr, body
   /// frames) and its 6x6 tangent covariance (the camr block of CalibrationFilter::covariance()).
@@ -40,8 +46,22 @@ class EpipolarMatcher {
   /// pixel noise of both images, times band_sigmas, clamped to [min_band, max_band].
   double bandHalfWidth(const Eigen::Vector2d& left, const Eigen::Vector2d& right) const;
 
+  /// The epipolar line of a left undistorted pixel (eq. 6, normalised so that l.dot(x) is a
+  /// distance in px) and the lines of the six sigma-perturbed x_camr.
+  struct Lines {
+    Eigen::Vector3d nominal;
+    Eigen::Vector3d sigma[6];
+  };
+  Lines lines(const Eigen::Vector2d& left) const;
+  /// bandHalfWidth with the left pixel's lines computed once.
+  double bandHalfWidth(const Lines& lines, const Eigen::Vector2d& right) const;
+  /// The same with another pixel noise (px per image) than config.pixel_sigma.
+  double bandHalfWidth(const Lines& lines, const Eigen::Vector2d& right, double pixel_sigma) const;
+
   /// Matches in undistorted coordinates. Keypoints flagged in left_used / right_used (may be
-  /// empty) take no part. Each right keypoint is used at most once.
+  /// empty) take no part. A match passes the descriptor bound and Lowe's ratio test from
+  /// both sides and is mutual (each keypoint the other's best), hence one-to-one. Sorted by
+  /// left index.
   std::vector<StereoMatch> match(const FeatureSet& left, const FeatureSet& right,
                                  const std::vector<char>& left_used,
                                  const std::vector<char>& right_used) const;
@@ -52,6 +72,7 @@ class EpipolarMatcher {
  private:
   FrontEndConfig config_;
   double min_depth_;
+  double max_depth_;
   Eigen::Matrix3d K_left_inv_ = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d K_right_ = Eigen::Matrix3d::Identity();
   Eigen::Isometry3d T_ropt_lopt_ = Eigen::Isometry3d::Identity();

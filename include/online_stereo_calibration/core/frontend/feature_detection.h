@@ -41,6 +41,9 @@ class SpatialGrid {
   double cell_ = 1.0;
 };
 
+/// Number of differing bits between two binary descriptors of `bytes` bytes.
+double hammingDistance(const unsigned char* a, const unsigned char* b, int bytes);
+
 /// The keypoints of one image with their descriptors, raw and undistorted positions.
 struct FeatureSet {
   std::vector<Eigen::Vector2d> raw;          ///< raw (distorted) pixel positions
@@ -56,6 +59,8 @@ struct FeatureSet {
   /// Normalised distance (see FrontEndConfig::max_descriptor_distance) between keypoint i
   /// and a descriptor row of the same type.
   double distance(int i, const cv::Mat& descriptor) const;
+  /// The same between keypoint i and keypoint j of `other` (same descriptor type).
+  double distance(int i, const FeatureSet& other, int j) const;
 };
 
 /// Detects and describes keypoints with the configured detector.

@@ -44,6 +44,38 @@ struct FrontEndConfig {
   /// Lowe's ratio: best distance < ratio * second best among the candidates, (0, 1].
   double ratio = 0.8;
 
+  // --- sub-pixel refinement and verification of every stereo pair (matches and tracks) ---
+  /// The left keypoint's patch is aligned into the right image (Lucas-Kanade, translation,
+  /// bias-compensated) from the matched right keypoint; the right pixel becomes the aligned
+  /// sub-pixel position. Half-size of the patch (px), [1, 15].
+  int patch_half_size = 4;
+  /// Largest move (px) of the alignment from the right keypoint, (0, 20].
+  double max_refinement_shift = 2.0;
+  /// Tracks: the point's patch in the previous left image is aligned into the current one
+  /// from the keypoint found; largest move (px) from that keypoint, (0, 20].
+  double max_temporal_shift = 3.0;
+  /// Least normalised cross-correlation of the aligned patches, [-1, 1]: below, the two
+  /// views show different things there (an occluding edge, a wrong match).
+  double min_patch_ncc = 0.9;
+  /// Search tracks whose keypoint was not detected again by aligning their patch from the
+  /// previous left image at the predicted pixel (more tracks survive, at some precision).
+  bool search_lost_tracks = false;
+  /// ... least NCC there, [-1, 1], and largest forward-backward error (px, aligned back
+  /// into the previous image), (0, 10].
+  double min_search_ncc = 0.95;
+  double max_forward_backward = 0.3;
+  /// Depth-discontinuity check of every refined pair: each half of the patch is matched at
+  /// shifts of up to this many px along the epipolar line; a textured half that prefers a
+  /// shift of >= 2 px means the pixel and its neighbours lie at different depths (an
+  /// occluding contour) and the pair is rejected. [0, 20]; 0 = off.
+  int discontinuity_search = 8;
+  /// Least ratio of the smaller to the larger eigenvalue of the patch's structure tensor,
+  /// [0, 1]: below, the patch is a straight edge (its position along the edge is unknown).
+  double min_patch_eigen_ratio = 0.05;
+  /// Pixel noise (px) per image of a refined pair: the refined right pixel must lie in the
+  /// epipolar band computed with it in place of pixel_sigma, (0, 10].
+  double refined_pixel_sigma = 0.35;
+
   // --- spatial sampling ---
   /// Bucketing grid (cells per axis) for new points: the best match per cell, and none in a
   /// cell that already holds a tracked point. [1, 64].
@@ -64,6 +96,12 @@ struct FrontEndConfig {
   double max_track_window = 40.0;  ///< [min_track_window, 500]
   /// Largest normalised descriptor distance of a track to its stored descriptor, (0, 1].
   double max_track_descriptor_distance = 0.2;
+  /// Ratio test of a track within its window: best distance < track_ratio * runner-up,
+  /// (0, 1]; 1 = off.
+  double track_ratio = 0.9;
+  /// Gate on the squared Mahalanobis distance (2 dof, under the filter's S) of a track's
+  /// keypoint from its predicted pixel in each image (13.8 = 99.9 %), (0, 1000].
+  double track_gate_chi2_2dof = 13.8;
 
   // --- input checks ---
   /// Least image size (px, each axis) accepted, [8, 10000].

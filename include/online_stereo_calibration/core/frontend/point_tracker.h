@@ -26,6 +26,9 @@ struct TrackWindow {
   Eigen::Vector2d right_center = Eigen::Vector2d::Zero();
   Eigen::Vector2d left_half = Eigen::Vector2d::Zero();  ///< half-size (px) per axis
   Eigen::Vector2d right_half = Eigen::Vector2d::Zero();
+  /// The prediction: [u_l, v_l, u_r, v_r] (undistorted px) and its innovation covariance.
+  Eigen::Vector4d z = Eigen::Vector4d::Zero();
+  Eigen::Matrix4d S = Eigen::Matrix4d::Identity();
 };
 
 /// A tracked point found again in both images (indices into the FeatureSets).
@@ -40,8 +43,13 @@ class PointTracker {
  public:
   explicit PointTracker(const FrontEndConfig& config);
 
-  /// Starts tracking a point with the descriptors it was found with.
-  void add(PointId id, const cv::Mat& left_descriptor, const cv::Mat& right_descriptor);
+  /// Starts tracking a point with the descriptors it was found with and its left raw pixel.
+  void add(PointId id, const cv::Mat& left_descriptor, const cv::Mat& right_descriptor,
+           const Eigen::Vector2d& left_pixel);
+  /// The left raw pixel (sub-pixel) where the point was last seen; false for an unknown id.
+  bool leftPixel(PointId id, Eigen::Vector2d* pixel) const;
+  /// Records where the point was seen in the left image of this pair.
+  void setLeftPixel(PointId id, const Eigen::Vector2d& pixel);
   void remove(PointId id);
   void clear() { tracks_.clear(); }
   bool has(PointId id) const { return tracks_.count(id) > 0; }
@@ -54,12 +62,15 @@ class PointTracker {
   std::vector<TrackWindow> windows(const std::vector<PredictedObservation>& predictions,
                                    const CameraModel& left, const CameraModel& right) const;
 
-  /// Finds each window's point in both images: the keypoint in the window closest in
-  /// descriptor to the stored one (within max_track_descriptor_distance); a keypoint serves
-  /// one track at most (the better match wins). Found keypoints are flagged in *_used, and
-  /// the stored descriptors are refreshed. Points not found in both images are not returned.
-  /// If given, `consistent(left_index, right_index)` must accept the right keypoint for the
-  /// chosen left one (e.g. the epipolar band of eq. 5-6).
+  /// Finds each window's point in both images: the keypoint in the window and inside the
+  /// Mahalanobis gate (track_gate_chi2_2dof; the right keypoint's gate conditioned on the
+  /// left keypoint through S) closest in descriptor to the stored one, within
+  /// max_track_descriptor_distance and passing the ratio test (track_ratio) against the
+  /// runner-up; the left and right keypoints must also match each other
+  /// (max_descriptor_distance). A keypoint serves one track at most (the better match wins). Found
+  /// keypoints are flagged in *_used, and the stored descriptors are refreshed. Points not found in
+  /// both images are not returned. If given, `consistent(left_index, right_index)` must accept the
+  /// right keypoint for the chosen left one (e.g. the epipolar band of eq. 5-6).
   std::vector<TrackMatch> track(const std::vector<TrackWindow>& windows, const FeatureSet& left,
                                 const FeatureSet& right, std::vector<char>* left_used,
                                 std::vector<char>* right_used,
@@ -69,6 +80,7 @@ class PointTracker {
   struct Track {
     cv::Mat left_descriptor;
     cv::Mat right_descriptor;
+    Eigen::Vector2d left_pixel = Eigen::Vector2d::Zero();
   };
   FrontEndConfig config_;
   std::unordered_map<PointId, Track> tracks_;

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
 
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
@@ -48,16 +49,20 @@ class StereoFrontEnd {
   const std::vector<StereoObservation>& lastTracked() const { return last_tracked_; }
   /// New candidates offered in the last pair (raw pixels, with their fresh ids).
   const std::vector<StereoObservation>& lastNewCandidates() const { return last_new_; }
-  /// All epipolar-guided matches of the last pair before the depth checks and bucketing
-  /// (raw pixels, id 0).
+  /// The epipolar-guided matches of the last pair that passed every check of a new point
+  /// (mutual descriptor match, depth range and parallax, sub-pixel alignment) before the
+  /// distance to tracks and bucketing select among them (raw pixels, refined right pixel,
+  /// id 0).
   const std::vector<StereoObservation>& lastStereoMatches() const { return last_matches_; }
   /// Search windows of the last pair.
   const std::vector<TrackWindow>& lastWindows() const { return last_windows_; }
   /// Points being tracked.
   size_t trackCount() const { return tracker_.size(); }
 
-  /// The last pair side by side (BGR): tracks green, new candidates blue, other stereo
-  /// matches grey, search windows yellow (left) / cyan (right). Empty before the first pair.
+  /// The last pair side by side (BGR): tracks green, new candidates blue with their
+  /// epipolar bands (centre line and band edges, eq. 5-6) magenta in the right image, other
+  /// stereo matches grey, search windows yellow (left) / cyan (right). Empty before the
+  /// first pair.
   cv::Mat debugImage() const;
 
   const FrontEndConfig& config() const { return config_; }
@@ -71,14 +76,24 @@ class StereoFrontEnd {
   PointTracker tracker_;
   PointId next_id_ = 1;
 
+  /// Polylines (raw right pixels) of one epipolar band: lower edge, centre, upper edge.
+  struct EpipolarBand {
+    std::vector<cv::Point2f> lines[3];
+  };
+  EpipolarBand bandPolylines(const Eigen::Vector2d& left_undistorted,
+                             const Eigen::Vector2d& right_undistorted) const;
+
   struct Pending {
     PointId id;
     cv::Mat left_descriptor, right_descriptor;
+    Eigen::Vector2d left_pixel;
   };
   std::vector<Pending> pending_;
   cv::Mat last_left_, last_right_;
+  cv::Mat previous_left_, current_left_;  ///< copies: the left images of the last two pairs
   std::vector<StereoObservation> last_tracked_, last_new_, last_matches_;
   std::vector<TrackWindow> last_windows_;
+  std::vector<EpipolarBand> last_bands_;
 };
 
 }  // namespace osc
