@@ -2,6 +2,7 @@
 /// @brief Aggregated calibration diagnostics.
 #include "online_stereo_calibration/ros/calibration_diagnostics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -49,26 +50,47 @@ CalibrationDiagnostics::CalibrationDiagnostics(ros::NodeHandle& nh, ros::NodeHan
   updater_.add("calibration", this, &CalibrationDiagnostics::produceStatus);
 }
 
-void CalibrationDiagnostics::tickPair() { pair_frequency_.tick(); }
+void CalibrationDiagnostics::tickPair() {
+  pair_frequency_.tick();
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++inputs_.pairs;
+}
+
 void CalibrationDiagnostics::tickProcessed() { processed_frequency_.tick(); }
-void CalibrationDiagnostics::tickOdom() { odom_frequency_.tick(); }
+
+void CalibrationDiagnostics::tickOdom() {
+  odom_frequency_.tick();
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++inputs_.odom;
+}
+
+void CalibrationDiagnostics::tickInput(bool left, bool camera_info) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++inputs_.value[(camera_info ? 2 : 0) + (left ? 0 : 1)];
+}
+
+void CalibrationDiagnostics::setInitialGuess(const std::string& description) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  initial_guess_ = description;
+}
 
 void CalibrationDiagnostics::recordProblem(const std::string& kind, const std::string& message) {
   std::lock_guard<std::mutex> lock(mutex_);
   last_problem_ = message;
-  for (auto& entry : counts_) {
-    if (entry.first == kind) {
-      ++entry.second;
+  for (Problem& problem : problems_) {
+    if (problem.kind == kind) {
+      ++problem.count;
+      problem.last_message = message;
       return;
     }
   }
-  counts_.emplace_back(kind, 1);
+  problems_.push_back({kind, 1, message});
 }
 
 int CalibrationDiagnostics::count(const std::string& kind) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  for (const auto& entry : counts_) {
-    if (entry.first == kind) return entry.second;
+  for (const Problem& problem : problems_) {
+    if (problem.kind == kind) return problem.count;
   }
   return 0;
 }
@@ -89,8 +111,41 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
   status.summary(DiagnosticStatus::OK, "calibrating");
   std::vector<std::string> reasons;
   unsigned char level = DiagnosticStatus::OK;
+  if (!initial_guess_.empty()) status.add("initial guess", initial_guess_);
+
+  // Inputs since the last report: images without camera_info never pair (ERROR, nothing can
+  // be processed), nor do images whose camera_info stamps differ; pairs without odometry
+  // cannot be processed either.
+  const auto since = [this](int index) {
+    return inputs_.value[index] - inputs_at_last_report_.value[index];
+  };
+  const int images = std::min(since(0), since(1));
+  const int pairs = inputs_.pairs - inputs_at_last_report_.pairs;
+  const int odom = inputs_.odom - inputs_at_last_report_.odom;
+  status.add("images since last report (left, right)",
+             std::to_string(since(0)) + ", " + std::to_string(since(1)));
+  status.add("camera_info since last report (left, right)",
+             std::to_string(since(2)) + ", " + std::to_string(since(3)));
+  status.add("pairs since last report", pairs);
+  status.add("odometry since last report", odom);
+  if (images > 0 && (since(2) == 0 || since(3) == 0)) {
+    level = DiagnosticStatus::ERROR;
+    const std::string which = since(2) == 0 && since(3) == 0 ? "left/camera_info, right/camera_info"
+                              : since(2) == 0                ? "left/camera_info"
+                                                             : "right/camera_info";
+    reasons.push_back("no camera_info on " + which + " (images arrive)");
+  } else if (images > 0 && pairs == 0) {
+    level = std::max<unsigned char>(level, DiagnosticStatus::WARN);
+    reasons.push_back("images and camera_info do not pair (stamps differ?)");
+  }
+  if (pairs > 0 && odom == 0 && config_.motion_source == MotionSourceType::kOdom) {
+    level = DiagnosticStatus::ERROR;
+    reasons.push_back("no odometry (image pairs arrive)");
+  }
+  inputs_at_last_report_ = inputs_;
+
   if (!have_estimate_) {
-    level = DiagnosticStatus::WARN;
+    level = std::max<unsigned char>(level, DiagnosticStatus::WARN);
     reasons.push_back("no image pair processed yet");
   } else {
     status.add("state", stateName(state_));
@@ -119,18 +174,19 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
     }
   }
   // Problems since the last report make the status WARN; totals are always listed.
-  for (const auto& entry : counts_) {
-    status.add(entry.first + " (total)", entry.second);
-    int before = 0;
-    for (const auto& old : counts_at_last_report_) {
-      if (old.first == entry.first) before = old.second;
-    }
-    if (entry.second > before) {
+  counts_at_last_report_.resize(problems_.size());
+  for (size_t i = 0; i < problems_.size(); ++i) {
+    const Problem& problem = problems_[i];
+    status.add(problem.kind + " (total)", problem.count);
+    status.add(problem.kind + " (last)", problem.last_message);
+    std::pair<std::string, int>& old = counts_at_last_report_[i];
+    if (old.first != problem.kind) old = {problem.kind, 0};  // problems_ only grows
+    if (problem.count > old.second) {
       level = std::max<unsigned char>(level, DiagnosticStatus::WARN);
-      reasons.push_back(entry.first);
+      reasons.push_back(problem.kind);
     }
+    old.second = problem.count;
   }
-  counts_at_last_report_ = counts_;
   if (!last_problem_.empty()) status.add("last problem", last_problem_);
   std::ostringstream summary;
   if (reasons.empty()) {

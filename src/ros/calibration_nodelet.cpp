@@ -10,21 +10,11 @@
 #include <sensor_msgs/image_encodings.h>
 #include <pluginlib/class_list_macros.hpp>
 
+#include "online_stereo_calibration/ros/conversions.h"
 #include "online_stereo_calibration/tools/calibration_file.h"
 
 namespace online_stereo_calibration {
 namespace {
-
-/// The tangent covariance whose parameter covariance is diag(sigmas^2).
-osc::Matrix12d tangentCovarianceFromSigmas(const osc::StereoExtrinsics& extrinsics,
-                                           const osc::Vector12d& sigmas) {
-  const osc::Matrix12d J = osc::parameterJacobian(extrinsics);
-  const osc::Matrix12d J_inv = J.inverse();
-  osc::Matrix12d P = osc::Matrix12d::Zero();
-  P.diagonal() = sigmas.cwiseProduct(sigmas);
-  osc::Matrix12d tangent = J_inv * P * J_inv.transpose();
-  return 0.5 * (tangent + tangent.transpose());
-}
 
 /// Image -> cv::Mat in an encoding the pipeline takes; empty with @p error if unsupported.
 cv_bridge::CvImageConstPtr toPipelineImage(const sensor_msgs::ImageConstPtr& image,
@@ -87,6 +77,10 @@ void CalibrationNodelet::onInit() {
   diagnostics_ = std::make_unique<CalibrationDiagnostics>(nh, pnh, config_.ros);
   motion_ = std::make_unique<MotionSource>(nh, config_.ros, tf_buffer_.get());
   motion_->on_odom = [this]() { diagnostics_->tickOdom(); };
+  motion_->on_problem = [this](const std::string& kind, const std::string& message) {
+    diagnostics_->recordProblem(kind, message);
+  };
+  diagnostics_->setInitialGuess(initial_guess_description_);
   output_ = std::make_unique<OutputPublisher>(nh, pnh, config_.ros.publish_tf);
 
   reset_srv_ = pnh.advertiseService("reset", &CalibrationNodelet::resetService, this);
@@ -111,6 +105,15 @@ void CalibrationNodelet::onInit() {
   right_sub_.subscribe(*it_, "right/image_raw", q);
   left_info_sub_.subscribe(nh, "left/camera_info", q);
   right_info_sub_.subscribe(nh, "right/camera_info", q);
+  // Count each input before pairing: images without camera_info never reach pairCallback.
+  left_sub_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
+      [this](const sensor_msgs::ImageConstPtr&) { diagnostics_->tickInput(true, false); }));
+  right_sub_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
+      [this](const sensor_msgs::ImageConstPtr&) { diagnostics_->tickInput(false, false); }));
+  left_info_sub_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(
+      [this](const sensor_msgs::CameraInfoConstPtr&) { diagnostics_->tickInput(true, true); }));
+  right_info_sub_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(
+      [this](const sensor_msgs::CameraInfoConstPtr&) { diagnostics_->tickInput(false, true); }));
   if (config_.ros.approximate_sync) {
     approximate_sync_ = std::make_unique<message_filters::Synchronizer<ApproximatePolicy>>(
         ApproximatePolicy(q), left_sub_, left_info_sub_, right_sub_, right_info_sub_);
@@ -130,13 +133,9 @@ void CalibrationNodelet::loadInitialGuess() {
   if (ros_config.resume) {
     std::ifstream probe(ros_config.calibration_file);
     if (probe.good()) {
-      const osc::CalibrationFile file = osc::readCalibrationFile(ros_config.calibration_file);
-      initial_guess_ = file.extrinsics;
-      if (file.sigmas) {
-        initial_covariance_ = tangentCovarianceFromSigmas(file.extrinsics, *file.sigmas);
-      }
-      NODELET_INFO("online_stereo_calibration: resuming from %s",
-                   ros_config.calibration_file.c_str());
+      seedFromFile(ros_config.calibration_file, "resumed from");
+      resumed_ = true;
+      NODELET_INFO("online_stereo_calibration: %s", initial_guess_description_.c_str());
       return;
     }
     NODELET_WARN("online_stereo_calibration: resume: %s does not exist, using the initial guess",
@@ -147,19 +146,33 @@ void CalibrationNodelet::loadInitialGuess() {
       osc::Vector12d parameters;
       parameters << ros_config.vehicle_to_left, ros_config.left_to_right;
       initial_guess_ = osc::StereoExtrinsics::fromParameters(parameters);
+      initial_guess_description_ = "from parameters, covariance from the configured sigmas";
       break;
     }
     case InitialGuessSource::kFile: {
-      const osc::CalibrationFile file = osc::readCalibrationFile(ros_config.initial_guess_file);
-      initial_guess_ = file.extrinsics;
-      if (file.sigmas) {
-        initial_covariance_ = tangentCovarianceFromSigmas(file.extrinsics, *file.sigmas);
-      }
+      seedFromFile(ros_config.initial_guess_file, "from");
       break;
     }
     case InitialGuessSource::kTf:
-      break;  // looked up at the first pair, when the optical frames are known
+      // Looked up at the first pair, when the optical frames are known.
+      initial_guess_description_ = "from tf, covariance from the configured sigmas";
+      break;
   }
+}
+
+void CalibrationNodelet::seedFromFile(const std::string& path, const std::string& verb) {
+  const osc::CalibrationFile file = osc::readCalibrationFile(path);
+  initial_guess_ = file.extrinsics;
+  initial_covariance_.reset();
+  const std::optional<osc::Matrix12d> covariance = osc::parameterCovariance(file);
+  if (covariance) {
+    initial_covariance_ = tangentCovarianceFromParameterCovariance(file.extrinsics, *covariance);
+  }
+  initial_guess_description_ =
+      verb + " " + path + ", " +
+      (file.covariance ? "full 12x12 covariance"
+       : file.sigmas   ? "diagonal covariance from its sigmas (no covariance key)"
+                       : "covariance from the configured sigmas (file has none)");
 }
 
 void CalibrationNodelet::pairCallback(const sensor_msgs::ImageConstPtr& left,
@@ -216,8 +229,11 @@ bool CalibrationNodelet::preparePipeline(const StereoPair& pair) {
     return false;
   }
   if (left.width != right.width || left.height != right.height || left.model != right.model) {
-    diagnostics_->recordProblem("left/right camera_info disagree",
-                                "left and right camera_info differ in size or distortion model");
+    diagnostics_->recordProblem(
+        "left/right camera_info disagree",
+        "left " + std::to_string(left.width) + "x" + std::to_string(left.height) + " " +
+            osc::distortionModelName(left.model) + ", right " + std::to_string(right.width) + "x" +
+            std::to_string(right.height) + " " + osc::distortionModelName(right.model));
     NODELET_WARN_THROTTLE(10.0,
                           "online_stereo_calibration: left (%dx%d, %s) and right (%dx%d, %s) "
                           "camera_info differ in size or model",
@@ -242,7 +258,7 @@ bool CalibrationNodelet::preparePipeline(const StereoPair& pair) {
     const osc::CalibrationEstimate estimate = pipeline_->estimate();
     guess = estimate.extrinsics;
     covariance = estimate.tangent_covariance;
-  } else if (config_.ros.initial_guess_source == InitialGuessSource::kTf && !config_.ros.resume) {
+  } else if (config_.ros.initial_guess_source == InitialGuessSource::kTf && !resumed_) {
     try {
       const ros::Duration timeout(config_.ros.tf_guess_timeout);
       const Eigen::Isometry3d T_veh_lopt = isometryFromTransform(
@@ -292,9 +308,9 @@ bool CalibrationNodelet::waitForMotion(const ros::Time& stamp, osc::MotionIncrem
       }
     }
   }
-  diagnostics_->recordProblem("motion gaps", "no motion for the pair at " +
-                                                 std::to_string(stamp.toSec()) + ": " +
-                                                 lookupStatusName(status));
+  diagnostics_->recordProblem("motion missing or late", "no motion for the pair at " +
+                                                            std::to_string(stamp.toSec()) + ": " +
+                                                            lookupStatusName(status));
   NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: pair at %.6f skipped: %s", stamp.toSec(),
                         lookupStatusName(status).c_str());
   return false;
@@ -325,7 +341,9 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
       std::lock_guard<std::mutex> lock(pipeline_mutex_);
       if (pipeline_) pipeline_->resetTracking();
     }
-    motion_->clear();
+    // Odometry that already jumped back itself (a bag loop) is kept; a history that holds
+    // only later stamps cannot serve the new time line.
+    if (motion_->poseAvailable(stamp) == LookupStatus::kTooOld) motion_->clear();
     last_stamp_ = ros::Time();
   }
   if (!preparePipeline(pair)) return;
@@ -431,6 +449,7 @@ bool CalibrationNodelet::saveCalibration(std::string* error) {
     }
     file.extrinsics = last_estimate_->extrinsics;
     file.sigmas = last_estimate_->sigmas();
+    file.covariance = last_estimate_->parameter_covariance;
     file.stamp = last_saved_stamp_.toSec();
   }
   try {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <Eigen/LU>
+
 namespace online_stereo_calibration {
 
 osc::CameraIntrinsics intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info) {
@@ -34,6 +36,13 @@ osc::CameraIntrinsics intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& in
   osc::CameraModel check(intrinsics);
   (void)check;
   return intrinsics;
+}
+
+osc::Matrix12d tangentCovarianceFromParameterCovariance(
+    const osc::StereoExtrinsics& extrinsics, const osc::Matrix12d& parameter_covariance) {
+  const osc::Matrix12d J_inv = osc::parameterJacobian(extrinsics).inverse();
+  const osc::Matrix12d tangent = J_inv * parameter_covariance * J_inv.transpose();
+  return 0.5 * (tangent + tangent.transpose());
 }
 
 bool intrinsicsDiffer(const osc::CameraIntrinsics& a, const osc::CameraIntrinsics& b) {

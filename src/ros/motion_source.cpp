@@ -23,13 +23,32 @@ void MotionSource::odomCallback(const nav_msgs::Odometry::ConstPtr& message) {
   if (!isFinitePose(message->pose.pose)) {
     ++rejected_samples;
     ROS_WARN_THROTTLE(5.0, "online_stereo_calibration: odometry with a non-finite pose ignored");
+    if (on_problem) on_problem("rejected odometry", "odometry with a non-finite pose ignored");
     return;
   }
   StampedPose sample{message->header.stamp.toSec(), isometryFromPose(message->pose.pose)};
   bool added = false;
+  double jumped_back = 0.0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     added = poses_.add(sample);
+    if (!added && !poses_.empty() && sample.stamp < poses_.newestStamp() - config_.max_motion_gap) {
+      // Time jumped back (a bag loop, a restarted player): start a new history.
+      jumped_back = poses_.newestStamp() - sample.stamp;
+      poses_.clear();
+      gyro_.clear();
+      added = poses_.add(sample);
+    }
+  }
+  if (jumped_back > 0.0) {
+    ROS_WARN(
+        "online_stereo_calibration: odometry time went back by %.3f s: motion history "
+        "cleared",
+        jumped_back);
+    if (on_problem) {
+      on_problem("time went backwards",
+                 "odometry time went back by " + std::to_string(jumped_back) + " s");
+    }
   }
   if (!added) {
     ++rejected_samples;
@@ -37,6 +56,10 @@ void MotionSource::odomCallback(const nav_msgs::Odometry::ConstPtr& message) {
                       "online_stereo_calibration: odometry stamp %.9f not newer than the last "
                       "one, ignored",
                       sample.stamp);
+    if (on_problem) {
+      on_problem("rejected odometry", "odometry stamp " + std::to_string(sample.stamp) +
+                                          " not newer than the last one, ignored");
+    }
     return;
   }
   if (on_odom) on_odom();
@@ -54,6 +77,7 @@ void MotionSource::imuCallback(const sensor_msgs::Imu::ConstPtr& message) {
     ++rejected_samples;
     ROS_WARN_THROTTLE(5.0,
                       "online_stereo_calibration: imu sample non-finite or out of order, ignored");
+    if (on_problem) on_problem("rejected imu", "imu sample non-finite or out of order, ignored");
     return;
   }
   if (on_imu) on_imu();

@@ -120,7 +120,7 @@ visualization_msgs::Marker label(const Eigen::Vector3d& position, const std::str
   marker.pose.position.y = position.y();
   marker.pose.position.z = position.z() + 0.1;
   marker.pose.orientation.w = 1.0;
-  marker.scale.z = 0.05;
+  marker.scale.z = 0.12;  // m, readable from a few metres
   marker.color.r = marker.color.g = marker.color.b = marker.color.a = 1.0f;
   marker.text = text;
   return marker;

@@ -11,6 +11,7 @@
 #include <functional>
 #include <initializer_list>
 #include <limits>
+#include <optional>
 #include <random>
 #include <set>
 #include <sstream>
@@ -242,6 +243,101 @@ TEST(CalibrationFile, SigmaKeysAreChecked) {
                              "b");
       },
       {"sigma_left_to_right[4]", "negative"});
+}
+
+/// A random symmetric positive definite 12x12 covariance with strong correlations.
+Matrix12d sampleCovariance(std::mt19937& rng) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Matrix12d A;
+  for (int i = 0; i < 144; ++i) A(i / 12, i % 12) = 1e-2 * normal(rng);
+  return A * A.transpose() + 1e-6 * Matrix12d::Identity();
+}
+
+TEST(CalibrationFile, FullCovarianceRoundTripsBitExactlyAndOldKeysStayReadable) {
+  TempDir dir;
+  std::mt19937 rng(11);
+  CalibrationFile written = sampleCalibration(rng);
+  const Matrix12d covariance = sampleCovariance(rng);
+  written.covariance = covariance;
+  written.sigmas = covariance.diagonal().cwiseSqrt();
+  const std::string path = dir.file("with_covariance.yaml");
+  writeCalibrationFileAtomic(path, written);
+
+  const CalibrationFile read = readCalibrationFile(path);
+  ASSERT_TRUE(read.covariance.has_value());
+  for (int i = 0; i < 144; ++i) {
+    EXPECT_EQ((*read.covariance)(i / 12, i % 12), covariance(i / 12, i % 12)) << i;
+  }
+  ASSERT_TRUE(parameterCovariance(read).has_value());
+  EXPECT_TRUE(*parameterCovariance(read) == covariance);
+
+  // A reader that predates the key (here: the same text without it) gets the same
+  // extrinsics and sigmas; the extra key is only more information.
+  const std::string text = readText(path);
+  const std::size_t at = text.find("covariance:");
+  ASSERT_NE(at, std::string::npos) << text;
+  EXPECT_EQ(text.find("covariance:", at + 1), std::string::npos) << "one key only";
+  const CalibrationFile old = parseCalibrationYaml(text.substr(0, at), "old");
+  expectSameBits(old.extrinsics, written.extrinsics);
+  ASSERT_TRUE(old.sigmas.has_value());
+  EXPECT_TRUE(*old.sigmas == *written.sigmas);
+  EXPECT_FALSE(old.covariance.has_value());
+}
+
+TEST(CalibrationFile, WithoutCovarianceTheSigmasGiveADiagonalOne) {
+  std::mt19937 rng(5);
+  CalibrationFile file = sampleCalibration(rng);
+  ASSERT_TRUE(file.sigmas.has_value());
+  const std::optional<Matrix12d> covariance = parameterCovariance(file);
+  ASSERT_TRUE(covariance.has_value());
+  for (int i = 0; i < 12; ++i) {
+    for (int j = 0; j < 12; ++j) {
+      EXPECT_EQ((*covariance)(i, j), i == j ? (*file.sigmas)(i) * (*file.sigmas)(i) : 0.0);
+    }
+  }
+  file.sigmas.reset();
+  EXPECT_FALSE(parameterCovariance(file).has_value());
+}
+
+TEST(CalibrationFile, CovarianceIsChecked) {
+  std::mt19937 rng(9);
+  const Matrix12d good = sampleCovariance(rng);
+  const auto yaml = [](const Matrix12d& c, int count) {
+    std::ostringstream out;
+    out.precision(17);
+    out << "covariance: [";
+    for (int i = 0; i < count; ++i) out << (i ? ", " : "") << c(i / 12, i % 12);
+    out << "]\n";
+    return out.str();
+  };
+  EXPECT_NO_THROW(parseCalibrationYaml(kValidYaml + yaml(good, 144), "good"));
+  expectThrowMentioning<std::runtime_error>(
+      [&] { parseCalibrationYaml(kValidYaml + yaml(good, 143), "short.yaml"); },
+      {"short.yaml", "covariance", "144"});
+  Matrix12d asymmetric = good;
+  asymmetric(0, 5) += 1e-3;
+  expectThrowMentioning<std::runtime_error>(
+      [&] { parseCalibrationYaml(kValidYaml + yaml(asymmetric, 144), "asym.yaml"); },
+      {"asym.yaml", "covariance", "symmetric"});
+  Matrix12d indefinite = good;
+  indefinite(4, 4) = -1e-3;
+  expectThrowMentioning<std::runtime_error>(
+      [&] { parseCalibrationYaml(kValidYaml + yaml(indefinite, 144), "indef.yaml"); },
+      {"indef.yaml", "covariance", "positive definite"});
+  Matrix12d with_nan = good;
+  with_nan(7, 7) = std::nan("");
+  expectThrowMentioning<std::runtime_error>(
+      [&] { parseCalibrationYaml(kValidYaml + yaml(with_nan, 144), "nan.yaml"); },
+      {"nan.yaml", "covariance[91]"});
+  // Sigmas that disagree with the covariance's diagonal (a hand-edited sigma).
+  expectThrowMentioning<std::runtime_error>(
+      [&] {
+        parseCalibrationYaml(kValidYaml + yaml(good, 144) +
+                                 "sigma_vehicle_to_left: [1, 1, 1, 1, 1, 1]\n"
+                                 "sigma_left_to_right: [1, 1, 1, 1, 1, 1]\n",
+                             "stale.yaml");
+      },
+      {"stale.yaml", "covariance[0]", "sigma"});
 }
 
 TEST(CalibrationFile, BadYamlAndMissingFileNameTheSource) {

@@ -133,6 +133,24 @@ TEST(CalibrationMessage, TransformsEqualParametersUnderInterfaceConventions) {
   EXPECT_NEAR(message.left_to_right.translation.x, 0.12, 0.01);
 }
 
+TEST(RestoredCovariance, TangentCovarianceMapsBackToTheFilesParameterCovariance) {
+  // A saved full parameter covariance P (strongly correlated) at a saved calibration: the
+  // tangent covariance seeding the filter must give P back through the filter's own map
+  // J T J^T (CalibrationFilter::parameterCovariance).
+  osc::Vector12d parameters;
+  parameters << 1.5, 0.15, 1.3, 0.02, 0.05, -0.03, 0.001, -0.3, 0.002, 0.001, -0.002, 0.003;
+  const osc::StereoExtrinsics extrinsics = osc::StereoExtrinsics::fromParameters(parameters);
+  osc::Matrix12d A;
+  for (int i = 0; i < 144; ++i) A(i / 12, i % 12) = 1e-2 * std::sin(1.0 + 7.0 * i);
+  const osc::Matrix12d P = A * A.transpose() + 1e-8 * osc::Matrix12d::Identity();
+  const osc::Matrix12d T = tangentCovarianceFromParameterCovariance(extrinsics, P);
+  EXPECT_LE((T - T.transpose()).cwiseAbs().maxCoeff(), 0.0);
+  const osc::Matrix12d J = osc::parameterJacobian(extrinsics);
+  EXPECT_LE((J * T * J.transpose() - P).cwiseAbs().maxCoeff(), 1e-12 * P.cwiseAbs().maxCoeff());
+  // Rotations make the tangent and parameter spaces differ: T is not P itself.
+  EXPECT_GT((T - P).cwiseAbs().maxCoeff(), 1e-6 * P.cwiseAbs().maxCoeff());
+}
+
 TEST(CalibrationState, FollowsPointsAndThresholds) {
   osc::CalibrationEstimate estimate;
   estimate.tracked_points = 50;

@@ -1,7 +1,8 @@
 /// @file calibration_diagnostics.h
 /// @brief /diagnostics through diagnostic_updater: a frequency monitor per input and one
-/// aggregated calibration status with its reasons (not converged, too few points, dropped
-/// pairs, stamp skew, motion gaps, 3-sigma of every parameter). Thread-safe.
+/// aggregated calibration status with its reasons (not converged, too few points, missing
+/// camera_info or odometry, every recorded input problem, 3-sigma of every parameter).
+/// Thread-safe.
 #pragma once
 
 #include <memory>
@@ -25,6 +26,11 @@ class CalibrationDiagnostics {
   void tickPair();       ///< a synchronised image pair arrived
   void tickProcessed();  ///< a pair went through the estimator
   void tickOdom();       ///< a motion sample arrived
+  /// A single input message arrived (before pairing): counts images and camera_info per
+  /// side, so that images without camera_info can be told apart from no input at all.
+  void tickInput(bool left, bool camera_info);
+  /// Where the initial guess and its covariance came from (shown in every report).
+  void setInitialGuess(const std::string& description);
   /// A problem with the input; counted under @p kind and kept as the latest message.
   void recordProblem(const std::string& kind, const std::string& message);
   /// The estimate after a processed pair and its StereoCalibration state.
@@ -37,6 +43,19 @@ class CalibrationDiagnostics {
  private:
   void produceStatus(diagnostic_updater::DiagnosticStatusWrapper& status);
 
+  /// One kind of problem: how often, and the latest message.
+  struct Problem {
+    std::string kind;
+    int count = 0;
+    std::string last_message;
+  };
+  /// Counts of single inputs (index: left image, right image, left info, right info).
+  struct InputCounts {
+    int value[4] = {0, 0, 0, 0};
+    int pairs = 0;
+    int odom = 0;
+  };
+
   RosConfig config_;
   double min_rate_;
   double max_rate_;
@@ -45,9 +64,12 @@ class CalibrationDiagnostics {
   diagnostic_updater::FrequencyStatus processed_frequency_;
   diagnostic_updater::FrequencyStatus odom_frequency_;
   mutable std::mutex mutex_;
-  std::vector<std::pair<std::string, int>> counts_;
+  std::vector<Problem> problems_;
   std::vector<std::pair<std::string, int>> counts_at_last_report_;
   std::string last_problem_;
+  InputCounts inputs_;
+  InputCounts inputs_at_last_report_;
+  std::string initial_guess_;
   bool have_estimate_ = false;
   osc::CalibrationEstimate estimate_;
   uint8_t state_ = 0;

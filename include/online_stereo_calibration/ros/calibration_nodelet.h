@@ -67,6 +67,10 @@ class CalibrationNodelet : public nodelet::Nodelet {
   bool saveCalibration(std::string* error);
   /// The initial guess (and tangent covariance if it comes from a file with sigmas).
   void loadInitialGuess();
+  /// Initial guess and covariance from a calibration file: its full covariance if it has
+  /// one, else diag(sigmas^2), else the configured initial sigmas. @p verb starts the
+  /// description shown in diagnostics ("resumed from", "from").
+  void seedFromFile(const std::string& path, const std::string& verb);
 
   NodeConfig config_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
@@ -95,7 +99,9 @@ class CalibrationNodelet : public nodelet::Nodelet {
   std::mutex pipeline_mutex_;
   std::unique_ptr<osc::CalibrationPipeline> pipeline_;
   osc::StereoExtrinsics initial_guess_;
-  std::optional<osc::Matrix12d> initial_covariance_;
+  std::optional<osc::Matrix12d> initial_covariance_;  ///< tangent space
+  std::string initial_guess_description_;
+  bool resumed_ = false;  ///< the guess came from calibration_file (resume)
   std::optional<osc::CalibrationEstimate> last_estimate_;
   ros::Time last_stamp_;
   ros::Time last_saved_stamp_;

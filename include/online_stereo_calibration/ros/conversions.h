@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "online_stereo_calibration/core/geometry/camera_model.h"
+#include "online_stereo_calibration/core/geometry/pose.h"
 
 namespace online_stereo_calibration {
 
@@ -28,6 +29,13 @@ Eigen::Isometry3d isometryFromPose(const geometry_msgs::Pose& pose);
 Eigen::Isometry3d isometryFromTransform(const geometry_msgs::Transform& transform);
 /// isometry -> geometry_msgs/Transform.
 geometry_msgs::Transform transformFromIsometry(const Eigen::Isometry3d& pose);
+
+/// The filter's tangent-space covariance whose parameter covariance (interface order, m and
+/// rad) at @p extrinsics is @p parameter_covariance: J^-1 P J^-T with J = parameterJacobian
+/// (the inverse of CalibrationFilter::parameterCovariance), symmetrised. Used to seed the
+/// filter from a calibration file's covariance (or its sigmas).
+osc::Matrix12d tangentCovarianceFromParameterCovariance(const osc::StereoExtrinsics& extrinsics,
+                                                        const osc::Matrix12d& parameter_covariance);
 
 /// True if every field of the pose is finite and the quaternion has a usable norm.
 bool isFinitePose(const geometry_msgs::Pose& pose);

@@ -37,6 +37,10 @@ class MotionSource {
   /// Called for each accepted odometry / imu sample (frequency diagnostics).
   std::function<void()> on_odom;
   std::function<void()> on_imu;
+  /// Called with a reason for each ignored sample (non-finite, out of order) and with a
+  /// description when odometry time jumped back by more than max_motion_gap (a bag loop:
+  /// the history is then cleared and the sample kept).
+  std::function<void(const std::string& kind, const std::string& message)> on_problem;
   /// Samples ignored (non-finite, duplicated or out-of-order stamps).
   std::atomic<int> rejected_samples{0};
 

@@ -7,8 +7,10 @@
 /// sigma_vehicle_to_left: [6]   # optional, 1-sigma of the parameters above
 /// sigma_left_to_right:   [6]   # optional (both sigma keys or neither)
 /// stamp: 1234.5                # optional, s
+/// covariance: [144]            # optional, 12x12 covariance of the 12 parameters, row-major
 /// ```
-/// Other keys are ignored when reading.
+/// Other keys are ignored when reading (so a reader that predates `covariance` still reads
+/// a file that has it).
 #pragma once
 
 #include <optional>
@@ -26,11 +28,19 @@ struct CalibrationFile {
   std::optional<Vector12d> sigmas;
   /// Time of the estimate (s), when the file has it.
   std::optional<double> stamp;
+  /// Full 12x12 covariance of the 12 parameters (m^2, m rad, rad^2), when the file has it.
+  /// Symmetric positive definite; its diagonal is sigmas^2 when both are present.
+  std::optional<Matrix12d> covariance;
 };
+
+/// The parameter covariance a file specifies: its full `covariance` if present, else
+/// diag(sigmas^2) if it has sigmas (cross-covariances then unknown, taken as 0), else none.
+std::optional<Matrix12d> parameterCovariance(const CalibrationFile& file);
 
 /// Parses the YAML text of a calibration file. Throws std::runtime_error naming
 /// @p source_name and the bad or missing key (missing, not a list of 6, not a number, NaN or
-/// infinite, negative sigma, only one of the two sigma keys).
+/// infinite, negative sigma, only one of the two sigma keys; a covariance that is not 144
+/// numbers, not symmetric, not positive definite or whose diagonal disagrees with the sigmas).
 CalibrationFile parseCalibrationYaml(const std::string& text, const std::string& source_name);
 
 /// Reads and parses a calibration file. Throws std::runtime_error naming the file (cannot

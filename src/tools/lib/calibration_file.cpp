@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
+#include <Eigen/Cholesky>
 
 namespace osc {
 namespace {
@@ -23,6 +25,7 @@ constexpr const char* kLeftToRight = "left_to_right";
 constexpr const char* kSigmaVehicleToLeft = "sigma_vehicle_to_left";
 constexpr const char* kSigmaLeftToRight = "sigma_left_to_right";
 constexpr const char* kStamp = "stamp";
+constexpr const char* kCovariance = "covariance";
 
 [[noreturn]] void fail(const std::string& source, const std::string& what) {
   throw std::runtime_error("calibration file '" + source + "': " + what);
@@ -50,6 +53,42 @@ Vector6d readVector6(const YAML::Node& root, const std::string& source, const st
     v(i) = readNumber(node[i], source, key + "[" + std::to_string(i) + "]");
   }
   return v;
+}
+
+/// The optional 12x12 covariance: 144 finite numbers, row-major, symmetric (to 1e-9 of its
+/// largest entry), positive definite, and its diagonal equal to sigmas^2 (to 1e-6) if the file
+/// has sigmas too (a hand-edited sigma with a stale covariance is refused, not guessed at).
+Matrix12d readCovariance(const YAML::Node& root, const std::string& source,
+                         const std::optional<Vector12d>& sigmas) {
+  const YAML::Node node = root[kCovariance];
+  if (!node.IsSequence() || node.size() != 144) {
+    fail(source,
+         std::string("key '") + kCovariance + "' must be a list of 144 numbers (12x12, row-major)");
+  }
+  Matrix12d covariance;
+  for (int i = 0; i < 144; ++i) {
+    covariance(i / 12, i % 12) =
+        readNumber(node[i], source, std::string(kCovariance) + "[" + std::to_string(i) + "]");
+  }
+  const double scale = covariance.cwiseAbs().maxCoeff();
+  if ((covariance - covariance.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale) {
+    fail(source, std::string("key '") + kCovariance + "' is not symmetric");
+  }
+  if (scale == 0.0 || Eigen::LLT<Matrix12d>(covariance).info() != Eigen::Success) {
+    fail(source, std::string("key '") + kCovariance + "' is not positive definite");
+  }
+  if (sigmas) {
+    for (int i = 0; i < 12; ++i) {
+      const double variance = (*sigmas)(i) * (*sigmas)(i);
+      if (std::abs(covariance(i, i) - variance) > 1e-6 * std::max(variance, covariance(i, i))) {
+        fail(source, std::string("key '") + kCovariance + "[" + std::to_string(13 * i) +
+                         "]' (a variance) disagrees with the square of its sigma; edit or "
+                         "remove '" +
+                         kCovariance + "'");
+      }
+    }
+  }
+  return covariance;  // as written (bit-exact round trip); users symmetrise if they need to
 }
 
 /// A number with 17 significant digits, locale-independent, always with a '.' in the
@@ -136,7 +175,16 @@ CalibrationFile parseCalibrationYaml(const std::string& text, const std::string&
     file.sigmas = sigmas;
   }
   if (root[kStamp]) file.stamp = readNumber(root[kStamp], source_name, kStamp);
+  if (root[kCovariance]) file.covariance = readCovariance(root, source_name, file.sigmas);
   return file;
+}
+
+std::optional<Matrix12d> parameterCovariance(const CalibrationFile& file) {
+  if (file.covariance) return *file.covariance;
+  if (!file.sigmas) return std::nullopt;
+  Matrix12d covariance = Matrix12d::Zero();
+  covariance.diagonal() = file.sigmas->cwiseProduct(*file.sigmas);
+  return covariance;
 }
 
 CalibrationFile readCalibrationFile(const std::string& path) {
@@ -151,7 +199,8 @@ CalibrationFile readCalibrationFile(const std::string& path) {
 std::string formatCalibrationYaml(const CalibrationFile& file) {
   const Vector12d p = file.extrinsics.toParameters();
   if (!p.allFinite() || (file.sigmas && !file.sigmas->allFinite()) ||
-      (file.stamp && !std::isfinite(*file.stamp))) {
+      (file.stamp && !std::isfinite(*file.stamp)) ||
+      (file.covariance && !file.covariance->allFinite())) {
     throw std::runtime_error("calibration: refusing to write NaN or infinite values");
   }
   std::string text =
@@ -166,6 +215,18 @@ std::string formatCalibrationYaml(const CalibrationFile& file) {
     text += std::string(kSigmaLeftToRight) + ": " + formatList(file.sigmas->tail<6>()) + "\n";
   }
   if (file.stamp) text += std::string(kStamp) + ": " + formatNumber(*file.stamp) + "\n";
+  if (file.covariance) {
+    // One flow list over 12 lines, a row of the matrix per line.
+    text += std::string(kCovariance) +
+            ":  # 12x12 covariance of the parameters above, row-major (m^2, m rad, rad^2)\n  [";
+    for (int i = 0; i < 12; ++i) {
+      for (int j = 0; j < 12; ++j) {
+        text += formatNumber((*file.covariance)(i, j));
+        if (j < 11) text += ", ";
+      }
+      text += i < 11 ? ",\n   " : "]\n";
+    }
+  }
   return text;
 }
 
