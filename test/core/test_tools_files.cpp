@@ -619,6 +619,7 @@ struct ToolOptions {
   double rate = 2.5;
   int first = 1000, last = 1150;
   bool verbose = false;
+  int hidden = -1;
 };
 
 CommandLine makeCli(ToolOptions* o) {
@@ -629,6 +630,7 @@ CommandLine makeCli(ToolOptions* o) {
   cli.option("--mode", &o->mode, "MODE", "mode").choices({"fast", "slow"});
   cli.option("--window", &o->first, &o->last, "FIRST LAST", "window").range(0, 1e9);
   cli.flag("--verbose", &o->verbose, "talk");
+  cli.option("--hidden", &o->hidden, "N", "no default shown").defaultText("");
   return cli;
 }
 
@@ -697,6 +699,7 @@ TEST(CommandLine, HelpListsEveryOptionWithDefaultsAndRanges) {
   EXPECT_NE(text.find("(required)"), std::string::npos);
   EXPECT_NE(text.find("--window FIRST LAST"), std::string::npos);
   EXPECT_NE(text.find("-h, --help"), std::string::npos);
+  EXPECT_NE(text.find("no default shown\n"), std::string::npos) << text;
   for (const std::string& line : {cli.usage()}) {
     std::istringstream lines(line);
     std::string l;

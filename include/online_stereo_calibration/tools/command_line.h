@@ -42,6 +42,8 @@ class CommandLine {
     Option& range(double low, double high);
     /// The value must be one of @p choices.
     Option& choices(std::vector<std::string> choices);
+    /// What help() shows as the default ("" shows none); the bound variable's value otherwise.
+    Option& defaultText(std::string text);
 
    private:
     friend class CommandLine;

@@ -66,6 +66,11 @@ CommandLine::Option& CommandLine::Option::choices(std::vector<std::string> value
   return *this;
 }
 
+CommandLine::Option& CommandLine::Option::defaultText(std::string text) {
+  default_text = std::move(text);
+  return *this;
+}
+
 CommandLine::CommandLine(std::string program, std::string description)
     : program_(std::move(program)), description_(std::move(description)) {}
 
