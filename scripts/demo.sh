@@ -6,7 +6,7 @@
 # and the paths of the convergence plots (like its Fig. 5 and 6).
 #
 # By default only the first 1151 frames (0-1150) of the 1500-frame drive are used: they hold the
-# step at 774 and Table I's window 1000-1150, and take about 2/3 of the time. OSC_DEMO_FRAMES=1500
+# step at 774 and Table I's window 1000-1150, and take about 3/4 of the time. OSC_DEMO_FRAMES=1500
 # runs the full drive (docs/RESULTS.md has both).
 #
 # The rendered drive is cached: simulate is skipped when out/demo/drive/ holds the bag and its
