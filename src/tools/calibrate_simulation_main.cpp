@@ -4,8 +4,12 @@
 //   calibrate_simulation [--scenario paper_offroad|urban_planar|drift] [--config PARAMS.yaml]
 //                        [--out DIR] [--frames N] [--seed N] [--window FIRST LAST]
 //
+// (the image-level counterpart, from rendered images through the front end, is `simulate` +
+// `evaluate`, which scripts/demo.sh runs).
+//
 // Writes DIR/estimates.csv (interface.md columns), DIR/reference.csv (the truth),
 // DIR/calibration.yaml (final estimate with sigmas, written atomically) and DIR/table.txt.
+#include <sys/stat.h>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -14,152 +18,153 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <sys/stat.h>
 
-#include "online_stereo_calibration/tools/output_directory.h"
 #include "online_stereo_calibration/core/sim/scenario_runner.h"
 #include "online_stereo_calibration/tools/calibration_file.h"
+#include "online_stereo_calibration/tools/command_line.h"
 #include "online_stereo_calibration/tools/estimates_csv.h"
 #include "online_stereo_calibration/tools/evaluation.h"
 #include "online_stereo_calibration/tools/filter_config_yaml.h"
+#include "online_stereo_calibration/tools/output_directory.h"
 
 namespace {
 
 struct Options {
   std::string scenario = "paper_offroad";
   std::string config;
-  std::string out = "out/demo";
+  std::string out = "out/calibrate_simulation";
   int frames = -1;
-  long seed = -1;
+  int seed = -1;
   int window_first = 1000, window_last = 1150;
 };
 
-void usage() {
-  std::cerr << "usage: calibrate_simulation [--scenario paper_offroad|urban_planar|drift]\n"
-               "         [--config PARAMS.yaml] [--out DIR] [--frames N] [--seed N]\n"
-               "         [--window FIRST LAST]\n";
-}
-
-Options parse(int argc, char** argv) {
-  Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const auto value = [&](const char* name) -> std::string {
-      if (i + 1 >= argc) throw std::invalid_argument(std::string(name) + " needs a value");
-      return argv[++i];
-    };
-    if (a == "--scenario") o.scenario = value("--scenario");
-    else if (a == "--config") o.config = value("--config");
-    else if (a == "--out") o.out = value("--out");
-    else if (a == "--frames") o.frames = std::stoi(value("--frames"));
-    else if (a == "--seed") o.seed = std::stol(value("--seed"));
-    else if (a == "--window") {
-      o.window_first = std::stoi(value("--window"));
-      o.window_last = std::stoi(value("--window"));
-    } else if (a == "--help" || a == "-h") {
-      usage();
-      std::exit(0);
-    } else {
-      throw std::invalid_argument("unknown argument '" + a + "'");
-    }
-  }
-  return o;
+/// The command line (`--help` prints it).
+osc::CommandLine commandLine(Options* o) {
+  osc::CommandLine cli("calibrate_simulation",
+                       "Calibrates a simulated drive at measurement level (simulated pixel tracks "
+                       "and vehicle motion,\nno images; the image-level run is simulate + "
+                       "evaluate, docs/evaluation.md) and prints\nthe RMSE beside the seed's "
+                       "Table I. Writes DIR/estimates.csv, reference.csv, calibration.yaml,\n"
+                       "table.txt.");
+  cli.option("--scenario", &o->scenario, "NAME", "measurement-level scenario")
+      .choices({"paper_offroad", "urban_planar", "drift"});
+  cli.option("--config", &o->config, "PARAMS.yaml",
+             "estimator parameters (config/default.yaml keys; a front_end: section is "
+             "checked, not used)");
+  cli.option("--out", &o->out, "DIR", "output directory");
+  cli.option("--frames", &o->frames, "N", "frames (-1: the scenario's)").range(1, 1e7);
+  cli.option("--seed", &o->seed, "N", "random seed (-1: the scenario's)").range(0, 2147483647);
+  cli.option("--window", &o->window_first, &o->window_last, "FIRST LAST",
+             "frames of the Table I RMSE (clipped to the drive)")
+      .range(0, 1e7);
+  return cli;
 }
 
 osc::MeasurementScenario scenarioByName(const std::string& name) {
   if (name == "paper_offroad") return osc::paperOffroadScenario();
   if (name == "urban_planar") return osc::urbanPlanarScenario();
   if (name == "drift") return osc::driftScenario();
-  throw std::invalid_argument("unknown scenario '" + name + "' (paper_offroad, urban_planar, drift)");
+  throw std::invalid_argument("unknown scenario '" + name +
+                              "' (paper_offroad, urban_planar, drift)");
 }
-
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    const Options options = parse(argc, argv);
-    osc::MeasurementScenario scenario = scenarioByName(options.scenario);
-    if (options.frames > 0) scenario.frames = options.frames;
-    if (options.seed >= 0) scenario.seed = static_cast<unsigned>(options.seed);
-    const osc::FilterConfig config =
-        options.config.empty() ? osc::FilterConfig() : osc::readFilterConfigFile(options.config);
-    osc::makeDirectories(options.out);
+  Options parsed;
+  osc::CommandLine cli = commandLine(&parsed);
+  return osc::runTool(
+      "calibrate_simulation", [&] { return cli.usage(); },
+      [&] {
+        if (!cli.parse(argc, argv)) return 0;
+        if (parsed.window_last < parsed.window_first) {
+          throw osc::CommandLineError("--window wants FIRST <= LAST");
+        }
+        const Options& options = parsed;
+        osc::MeasurementScenario scenario = scenarioByName(options.scenario);
+        if (options.frames > 0) scenario.frames = options.frames;
+        if (options.seed >= 0) scenario.seed = static_cast<unsigned>(options.seed);
+        const osc::FilterConfig config = options.config.empty()
+                                             ? osc::FilterConfig()
+                                             : osc::readFilterConfigFile(options.config);
+        osc::makeDirectories(options.out);
 
-    osc::EstimatesCsvWriter estimates(options.out + "/estimates.csv");
-    osc::ReferenceCsvWriter reference(options.out + "/reference.csv");
-    std::vector<osc::EstimateRow> estimate_rows;
-    std::vector<osc::ReferenceRow> reference_rows;
-    std::vector<double> times;
-    int jumps = 0;
-    const auto start = std::chrono::steady_clock::now();
-    std::cerr << "calibrating simulated drive '" << scenario.name << "': " << scenario.frames
-              << " frames at " << scenario.rate_hz << " Hz, seed " << scenario.seed << "\n";
+        osc::EstimatesCsvWriter estimates(options.out + "/estimates.csv");
+        osc::ReferenceCsvWriter reference(options.out + "/reference.csv");
+        std::vector<osc::EstimateRow> estimate_rows;
+        std::vector<osc::ReferenceRow> reference_rows;
+        std::vector<double> times;
+        int jumps = 0;
+        const auto start = std::chrono::steady_clock::now();
+        std::cerr << "calibrating simulated drive '" << scenario.name << "': " << scenario.frames
+                  << " frames at " << scenario.rate_hz << " Hz, seed " << scenario.seed << "\n";
 
-    const auto on_frame = [&](const osc::ScenarioFrameResult& r) {
-      osc::EstimateRow e;
-      e.frame = r.frame;
-      e.stamp = r.stamp;
-      e.parameters = r.parameters;
-      e.sigmas = r.sigmas;
-      e.tracked_points = r.tracked_points;
-      e.time_ms = r.time_ms;
-      estimates.write(e);
-      estimate_rows.push_back(e);
-      osc::ReferenceRow ref;
-      ref.frame = r.frame;
-      ref.stamp = r.stamp;
-      ref.parameters = r.truth;
-      reference.write(ref);
-      reference_rows.push_back(ref);
-      times.push_back(r.time_ms);
-      if (r.jump_detected) {
-        ++jumps;
-        std::cerr << "  frame " << r.frame << ": sudden calibration change detected, re-converging\n";
-      }
-      if ((r.frame + 1) % 100 == 0 || r.frame + 1 == scenario.frames) {
-        const double elapsed =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        const double rate = (r.frame + 1) / std::max(elapsed, 1e-9);
-        std::fprintf(stderr, "  frame %5d/%d  %6.0f frames/s  ETA %4.0f s  points %3d\n", r.frame + 1,
-                     scenario.frames, rate, (scenario.frames - r.frame - 1) / rate, r.tracked_points);
-      }
-    };
-    const auto results = osc::runMeasurementScenario(scenario, config, on_frame);
-    estimates.flush();
-    reference.flush();
+        const auto on_frame = [&](const osc::ScenarioFrameResult& r) {
+          osc::EstimateRow e;
+          e.frame = r.frame;
+          e.stamp = r.stamp;
+          e.parameters = r.parameters;
+          e.sigmas = r.sigmas;
+          e.tracked_points = r.tracked_points;
+          e.time_ms = r.time_ms;
+          estimates.write(e);
+          estimate_rows.push_back(e);
+          osc::ReferenceRow ref;
+          ref.frame = r.frame;
+          ref.stamp = r.stamp;
+          ref.parameters = r.truth;
+          reference.write(ref);
+          reference_rows.push_back(ref);
+          times.push_back(r.time_ms);
+          if (r.jump_detected) {
+            ++jumps;
+            std::cerr << "  frame " << r.frame
+                      << ": sudden calibration change detected, re-converging\n";
+          }
+          if ((r.frame + 1) % 100 == 0 || r.frame + 1 == scenario.frames) {
+            const double elapsed =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            const double rate = (r.frame + 1) / std::max(elapsed, 1e-9);
+            std::fprintf(stderr, "  frame %5d/%d  %6.0f frames/s  ETA %4.0f s  points %3d\n",
+                         r.frame + 1, scenario.frames, rate, (scenario.frames - r.frame - 1) / rate,
+                         r.tracked_points);
+          }
+        };
+        const auto results = osc::runMeasurementScenario(scenario, config, on_frame);
+        estimates.flush();
+        reference.flush();
 
-    osc::CalibrationFile final_calibration;
-    final_calibration.extrinsics = osc::StereoExtrinsics::fromParameters(results.back().parameters);
-    final_calibration.sigmas = results.back().sigmas;
-    final_calibration.stamp = results.back().stamp;
-    osc::writeCalibrationFileAtomic(options.out + "/calibration.yaml", final_calibration);
+        osc::CalibrationFile final_calibration;
+        final_calibration.extrinsics =
+            osc::StereoExtrinsics::fromParameters(results.back().parameters);
+        final_calibration.sigmas = results.back().sigmas;
+        final_calibration.stamp = results.back().stamp;
+        osc::writeCalibrationFileAtomic(options.out + "/calibration.yaml", final_calibration);
 
-    std::sort(times.begin(), times.end());
-    const double median = times[times.size() / 2];
-    const double p95 = times[std::min(times.size() - 1, times.size() * 95 / 100)];
-    std::ostringstream text;
-    const int last = std::min(options.window_last, scenario.frames - 1);
-    const int first = std::min(options.window_first, std::max(0, last - 150));
-    const osc::EvaluationReport report = osc::evaluateWindow(estimate_rows, reference_rows, first, last);
-    text << "Scenario " << scenario.name << " (measurement level, seed " << scenario.seed
-         << "), RMSE over frames " << first << "-" << last << ":\n"
-         << osc::formatTableI(report) << "\n";
-    if (scenario.step_frame >= 0 && scenario.step_frame < scenario.frames) {
-      const int back = osc::framesToConverge(estimate_rows, reference_rows, 5, 0.3 * M_PI / 180.0,
-                                             scenario.step_frame);
-      text << "Step of x_caml at frame " << scenario.step_frame << ": yaw_l within 0.3 deg from frame "
-           << back << " on (" << (back >= 0 ? back - scenario.step_frame : -1) << " frames)\n";
-    }
-    text << "Sudden changes detected: " << jumps << "\n"
-         << "Estimator time per frame: median " << median << " ms, p95 " << p95 << " ms\n";
-    std::cout << text.str();
-    std::ofstream(options.out + "/table.txt") << text.str();
-    std::cout << "wrote " << options.out << "/estimates.csv, reference.csv, calibration.yaml, table.txt\n";
-    return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "calibrate_simulation: " << e.what() << "\n";
-    usage();
-    return 1;
-  }
+        std::sort(times.begin(), times.end());
+        const double median = times[times.size() / 2];
+        const double p95 = times[std::min(times.size() - 1, times.size() * 95 / 100)];
+        std::ostringstream text;
+        const int last = std::min(options.window_last, scenario.frames - 1);
+        const int first = std::min(options.window_first, std::max(0, last - 150));
+        const osc::EvaluationReport report =
+            osc::evaluateWindow(estimate_rows, reference_rows, first, last);
+        text << "Scenario " << scenario.name << " (measurement level, seed " << scenario.seed
+             << "), RMSE over frames " << first << "-" << last << ":\n"
+             << osc::formatTableI(report) << "\n";
+        if (scenario.step_frame >= 0 && scenario.step_frame < scenario.frames) {
+          const int back = osc::framesToConverge(estimate_rows, reference_rows, 5,
+                                                 0.3 * M_PI / 180.0, scenario.step_frame);
+          text << "Step of x_caml at frame " << scenario.step_frame
+               << ": yaw_l within 0.3 deg from frame " << back << " on ("
+               << (back >= 0 ? back - scenario.step_frame : -1) << " frames)\n";
+        }
+        text << "Sudden changes detected: " << jumps << "\n"
+             << "Estimator time per frame: median " << median << " ms, p95 " << p95 << " ms\n";
+        std::cout << text.str();
+        std::ofstream(options.out + "/table.txt") << text.str();
+        std::cout << "wrote " << options.out
+                  << "/estimates.csv, reference.csv, calibration.yaml, table.txt\n";
+        return 0;
+      });
 }

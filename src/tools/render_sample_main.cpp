@@ -15,6 +15,7 @@
 
 #include "online_stereo_calibration/core/geometry/pose.h"
 #include "online_stereo_calibration/core/sim/stereo_scene_renderer.h"
+#include "online_stereo_calibration/tools/command_line.h"
 
 namespace {
 
@@ -27,42 +28,38 @@ struct Arguments {
   double x = 0.0, y = 0.0, yaw = 0.0, pitch = 0.05, baseline = 0.5;
 };
 
-Arguments parse(int argc, char** argv) {
-  Arguments a;
-  for (int i = 1; i < argc; ++i) {
-    const std::string key = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw std::invalid_argument("missing value after " + key);
-      return argv[++i];
-    };
-    if (key == "--out")
-      a.out = value();
-    else if (key == "--seed")
-      a.seed = static_cast<unsigned>(std::stoul(value()));
-    else if (key == "--size") {
-      const std::string s = value();
-      const size_t x = s.find('x');
-      if (x == std::string::npos) throw std::invalid_argument("--size wants WxH");
-      a.width = std::stoi(s.substr(0, x));
-      a.height = std::stoi(s.substr(x + 1));
-    } else if (key == "--color")
-      a.color = true;
-    else if (key == "--distortion")
-      a.distortion = value();
-    else if (key == "--x")
-      a.x = std::stod(value());
-    else if (key == "--y")
-      a.y = std::stod(value());
-    else if (key == "--yaw")
-      a.yaw = std::stod(value());
-    else if (key == "--pitch")
-      a.pitch = std::stod(value());
-    else if (key == "--baseline")
-      a.baseline = std::stod(value());
-    else
-      throw std::invalid_argument("unknown argument " + key);
-  }
-  return a;
+/// The command line (`--help` prints it); --size WxH is split after parsing.
+osc::CommandLine commandLine(Arguments* a, std::string* size, int* seed) {
+  osc::CommandLine cli("render_sample",
+                       "Writes one rendered stereo pair of the procedural scene as "
+                       "DIR/left.png and DIR/right.png.");
+  cli.option("--out", &a->out, "DIR", "output directory (must exist)");
+  cli.option("--seed", seed, "N", "scene seed").range(0, 2147483647);
+  cli.option("--size", size, "WxH", "image size");
+  cli.flag("--color", &a->color, "render in colour (bgr8)");
+  cli.option("--distortion", &a->distortion, "MODEL", "lens distortion")
+      .choices({"none", "plumb_bob", "rational_polynomial", "equidistant"});
+  cli.option("--x", &a->x, "X", "camera x (m)");
+  cli.option("--y", &a->y, "Y", "camera y (m)");
+  cli.option("--yaw", &a->yaw, "RAD", "camera yaw");
+  cli.option("--pitch", &a->pitch, "RAD", "camera pitch").range(-1.5, 1.5);
+  cli.option("--baseline", &a->baseline, "B", "stereo baseline (m)").range(0.0, 10.0);
+  return cli;
+}
+
+/// "640x480" -> width, height; throws CommandLineError otherwise.
+void parseSize(const std::string& text, Arguments* a) {
+  const size_t x = text.find('x');
+  const auto number = [&](const std::string& part) {
+    if (part.empty() || part.find_first_not_of("0123456789") != std::string::npos ||
+        part.size() > 5 || std::stoi(part) < 8 || std::stoi(part) > 10000) {
+      throw osc::CommandLineError("--size: '" + text + "' is not WxH with 8 <= W, H <= 10000");
+    }
+    return std::stoi(part);
+  };
+  if (x == std::string::npos) number("");
+  a->width = number(text.substr(0, x));
+  a->height = number(text.substr(x + 1));
 }
 
 osc::CameraModel makeCamera(const Arguments& a) {
@@ -84,33 +81,39 @@ osc::CameraModel makeCamera(const Arguments& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    const Arguments a = parse(argc, argv);
-    osc::SceneConfig config;
-    config.seed = a.seed;
-    const osc::StereoSceneRenderer renderer(config);
-    const osc::CameraModel camera = makeCamera(a);
-    osc::Vector6d body;
-    body << a.x, a.y, renderer.scene().groundHeight(a.x, a.y) + 1.5, 0.0, a.pitch, a.yaw;
-    const Eigen::Isometry3d T_world_left = osc::poseFromParameters(body) * osc::bodyFromOptical();
-    Eigen::Isometry3d T_left_right = Eigen::Isometry3d::Identity();
-    T_left_right.translation() = Eigen::Vector3d(a.baseline, 0.0, 0.0);  // optical x is right
-    osc::RenderOptions options;
-    options.color = a.color;
-    const auto start = std::chrono::steady_clock::now();
-    const cv::Mat left = renderer.render(camera, T_world_left, options);
-    const auto middle = std::chrono::steady_clock::now();
-    const cv::Mat right = renderer.render(camera, T_world_left * T_left_right, options);
-    const auto end = std::chrono::steady_clock::now();
-    cv::imwrite(a.out + "/left.png", left);
-    cv::imwrite(a.out + "/right.png", right);
-    std::cout << "left " << std::chrono::duration<double, std::milli>(middle - start).count()
-              << " ms (with the ray cache), right "
-              << std::chrono::duration<double, std::milli>(end - middle).count() << " ms; "
-              << renderer.scene().primitives().size() << " primitives\n";
-    return EXIT_SUCCESS;
-  } catch (const std::exception& e) {
-    std::cerr << "render_sample: " << e.what() << "\n";
-    return EXIT_FAILURE;
-  }
+  Arguments a;
+  std::string size = "640x480";
+  int seed = static_cast<int>(a.seed);
+  osc::CommandLine cli = commandLine(&a, &size, &seed);
+  return osc::runTool(
+      "render_sample", [&] { return cli.usage(); },
+      [&] {
+        if (!cli.parse(argc, argv)) return EXIT_SUCCESS;
+        parseSize(size, &a);
+        a.seed = static_cast<unsigned>(seed);
+        osc::SceneConfig config;
+        config.seed = a.seed;
+        const osc::StereoSceneRenderer renderer(config);
+        const osc::CameraModel camera = makeCamera(a);
+        osc::Vector6d body;
+        body << a.x, a.y, renderer.scene().groundHeight(a.x, a.y) + 1.5, 0.0, a.pitch, a.yaw;
+        const Eigen::Isometry3d T_world_left =
+            osc::poseFromParameters(body) * osc::bodyFromOptical();
+        Eigen::Isometry3d T_left_right = Eigen::Isometry3d::Identity();
+        T_left_right.translation() = Eigen::Vector3d(a.baseline, 0.0, 0.0);  // optical x is right
+        osc::RenderOptions options;
+        options.color = a.color;
+        const auto start = std::chrono::steady_clock::now();
+        const cv::Mat left = renderer.render(camera, T_world_left, options);
+        const auto middle = std::chrono::steady_clock::now();
+        const cv::Mat right = renderer.render(camera, T_world_left * T_left_right, options);
+        const auto end = std::chrono::steady_clock::now();
+        cv::imwrite(a.out + "/left.png", left);
+        cv::imwrite(a.out + "/right.png", right);
+        std::cout << "left " << std::chrono::duration<double, std::milli>(middle - start).count()
+                  << " ms (with the ray cache), right "
+                  << std::chrono::duration<double, std::milli>(end - middle).count() << " ms; "
+                  << renderer.scene().primitives().size() << " primitives\n";
+        return EXIT_SUCCESS;
+      });
 }

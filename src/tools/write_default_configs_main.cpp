@@ -3,25 +3,34 @@
 //   write_default_configs CONFIG_DIR
 #include <fstream>
 #include <iostream>
+#include <string>
+#include <vector>
 
+#include "online_stereo_calibration/tools/command_line.h"
 #include "online_stereo_calibration/tools/filter_config_yaml.h"
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::cerr << "usage: write_default_configs CONFIG_DIR\n";
-    return 2;
-  }
-  const std::string dir = argv[1];
-  std::ofstream(dir + "/default.yaml")
-      << osc::formatFilterConfigYaml(osc::FilterConfig(),
-                                     "online_stereo_calibration: shipped defaults (docs/RESULTS.md "
-                                     "has the figures behind every value that differs from "
-                                     "paper.yaml)");
-  std::ofstream(dir + "/paper.yaml")
-      << osc::formatFilterConfigYaml(osc::paperFilterConfig(),
-                                     "online_stereo_calibration: the seed paper's values (Mueller "
-                                     "& Wuensche 2016, eq. 10-15); values the paper does not give "
-                                     "are our defaults");
-  std::cout << "wrote " << dir << "/default.yaml and " << dir << "/paper.yaml\n";
-  return 0;
+  std::vector<std::string> directories;
+  osc::CommandLine cli("write_default_configs",
+                       "Writes CONFIG_DIR/default.yaml (the shipped defaults) and "
+                       "CONFIG_DIR/paper.yaml (the seed's values)\nfrom the code.");
+  cli.positional(&directories, 1, "CONFIG_DIR", "directory to write into (e.g. config)");
+  return osc::runTool(
+      "write_default_configs", [&] { return cli.usage(); },
+      [&] {
+        if (!cli.parse(argc, argv)) return 0;
+        const std::string dir = directories.front();
+        std::ofstream(dir + "/default.yaml") << osc::formatFilterConfigYaml(
+            osc::FilterConfig(),
+            "online_stereo_calibration: shipped defaults (docs/RESULTS.md "
+            "has the figures behind every value that differs from "
+            "paper.yaml)");
+        std::ofstream(dir + "/paper.yaml") << osc::formatFilterConfigYaml(
+            osc::paperFilterConfig(),
+            "online_stereo_calibration: the seed paper's values (Mueller "
+            "& Wuensche 2016, eq. 10-15); values the paper does not give "
+            "are our defaults");
+        std::cout << "wrote " << dir << "/default.yaml and " << dir << "/paper.yaml\n";
+        return 0;
+      });
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -250,5 +251,121 @@ TEST(BagTools, SimulateThenEvaluateShortDrive) {
   EXPECT_NEAR(tableRmse("yaw_l"), yaw_l, 1e-5 + 1e-4 * yaw_l);
   EXPECT_NE(table.find("time per frame: median"), std::string::npos);
   EXPECT_NE(table.find("mean NEES"), std::string::npos);
+
+  // A missing topic is named with its option, and the bag's topics are listed.
+  const auto run = [&](const std::string& arguments, const std::string& log) {
+    return std::system((evaluate + " " + arguments + " > " + dir + "/" + log + " 2>&1").c_str());
+  };
+  EXPECT_NE(run("--bag " + bag_path + " --out " + dir + "/bad --odom /nope", "missing.log"), 0);
+  const std::string missing = readText(dir + "/missing.log");
+  EXPECT_NE(missing.find("--odom /nope: not in the bag"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("/stereo/left/image_raw  sensor_msgs/Image  (60 messages)"),
+            std::string::npos)
+      << missing;
+  EXPECT_NE(missing.find("/odom  nav_msgs/Odometry"), std::string::npos) << missing;
+  EXPECT_NE(run("--bag " + bag_path + " --out " + dir + "/bad --stereo-ns /cam", "ns.log"), 0);
+  EXPECT_NE(readText(dir + "/ns.log").find("--right-info /cam/right/camera_info: not in the bag"),
+            std::string::npos);
+  EXPECT_NE(run("--bag " + bag_path + " --out " + dir + "/bad --left-info /odom", "type.log"), 0);
+  EXPECT_NE(readText(dir + "/type.log")
+                .find("--left-info /odom: holds nav_msgs/Odometry, not sensor_msgs/CameraInfo"),
+            std::string::npos);
+  // Command-line and configuration errors name the option or key (exit 2 / 1, no output dir).
+  EXPECT_NE(run("--bag " + bag_path + " --out " + dir + "/bad --windoww 1 2", "cli.log"), 0);
+  EXPECT_NE(readText(dir + "/cli.log").find("unknown option '--windoww'"), std::string::npos);
+  {
+    std::ofstream bad(dir + "/bad_config.yaml");
+    bad << "pixel_noise_px: 0.5\nfront_end: {detector: ORB, max_featurez: 10}\n";
+  }
+  EXPECT_NE(run("--bag " + bag_path + " --out " + dir + "/bad --config " + dir + "/bad_config.yaml",
+                "config.log"),
+            0);
+  EXPECT_NE(readText(dir + "/config.log").find("front_end.max_featurez: unknown parameter"),
+            std::string::npos)
+      << readText(dir + "/config.log");
+  EXPECT_FALSE(isFile(dir + "/bad/estimates.csv"));
+
+  // Other topic names: the first 12 frames copied under new names, evaluated with the topic
+  // options and a front-end configuration from the --config file.
+  const std::string renamed = dir + "/renamed.bag";
+  {
+    rosbag::Bag in(bag_path, rosbag::bagmode::Read);
+    rosbag::Bag out(renamed, rosbag::bagmode::Write);
+    const std::map<std::string, std::string> names = {{"/stereo/left/image_raw", "/cam0/image"},
+                                                      {"/stereo/right/image_raw", "/cam1/image"},
+                                                      {"/stereo/left/camera_info", "/cam0/info"},
+                                                      {"/stereo/right/camera_info", "/cam1/info"},
+                                                      {"/odom", "/ins/odometry"}};
+    const double end = reference[11].stamp + 0.05;
+    for (const rosbag::MessageInstance& m : rosbag::View(in)) {
+      const auto name = names.find(m.getTopic());
+      if (name == names.end() || m.getTime().toSec() > end) continue;
+      out.write(name->second, m.getTime(), m);
+    }
+  }
+  {
+    std::ofstream good(dir + "/config.yaml");
+    good << "front_end:\n  detector: FAST_ORB\n  max_features: 600\n";
+  }
+  ASSERT_EQ(run("--bag " + renamed + " --out " + dir + "/renamed --initial-guess " + dir +
+                    "/sim/initial_guess.yaml --left-image /cam0/image --right-image /cam1/image "
+                    "--left-info /cam0/info --right-info /cam1/info --odom /ins/odometry "
+                    "--config " +
+                    dir + "/config.yaml --reference " + dir + "/sim/truth.yaml",
+                "renamed.log"),
+            0)
+      << readText(dir + "/renamed.log");
+  const std::string renamed_log = readText(dir + "/renamed.log");
+  EXPECT_NE(renamed_log.find("on /cam0/image"), std::string::npos) << renamed_log;
+  EXPECT_NE(renamed_log.find("FAST_ORB front end"), std::string::npos) << renamed_log;
+  EXPECT_GE(osc::readEstimatesCsv(dir + "/renamed/estimates.csv").size(), 10u);
+  std::system(("rm -rf " + dir).c_str());
+}
+
+/// scripts/demo.sh on a tiny drive: renders and evaluates, prints the table and the plots,
+/// reuses the rendered drive on a second run and renders again once the scenario changes.
+TEST(BagTools, DemoScriptCachesTheRenderedDrive) {
+  const std::string simulate = findTool("simulate");
+  if (simulate.empty() || findTool("evaluate").empty()) {
+    GTEST_SKIP() << "simulate/evaluate not built (make simulate evaluate)";
+  }
+  char dir_template[] = "/tmp/osc_demo_XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  const auto writeScenario = [&](const std::string& extra) {
+    std::ofstream scenario(dir + "/tiny.yaml");
+    scenario << "base: paper_offroad\nname: tiny\nframes: 1500\n"
+                "left_camera: {width: 240, height: 180, fx: 220, fy: 220, cx: 119.5, cy: 89.5}\n"
+                "right_camera: {width: 240, height: 180, fx: 220, fy: 220, cx: 119.5, cy: 89.5}\n"
+                "rendering: {supersampling: 1}\n"
+             << extra;
+  };
+  writeScenario("");
+  const std::string bin_dir = simulate.substr(0, simulate.find_last_of('/'));
+  const auto demo = [&](const std::string& log) {
+    const std::string command = "OSC_DEMO_SKIP_BUILD=1 OSC_DEMO_BIN_DIR=" + bin_dir +
+                                " OSC_DEMO_FRAMES=8 OSC_DEMO_SCENARIO=" + dir +
+                                "/tiny.yaml OSC_DEMO_OUT=" + dir + "/out bash " +
+                                std::string(OSC_SOURCE_DIR) + "/scripts/demo.sh > " + dir + "/" +
+                                log + " 2>&1";
+    return std::system(command.c_str());
+  };
+  ASSERT_EQ(demo("first.log"), 0) << readText(dir + "/first.log");
+  const std::string first = readText(dir + "/first.log");
+  EXPECT_NE(first.find("demo: rendering 8 frames"), std::string::npos) << first;
+  EXPECT_NE(first.find("Table I"), std::string::npos) << first;
+  EXPECT_NE(first.find("Convergence plots:"), std::string::npos) << first;
+  EXPECT_NE(first.find(dir + "/out/eval/errors.png"), std::string::npos) << first;
+  EXPECT_EQ(osc::readReferenceCsv(dir + "/out/drive/reference.csv").size(), 8u);
+  EXPECT_GE(osc::readEstimatesCsv(dir + "/out/eval/estimates.csv").size(), 6u);
+
+  ASSERT_EQ(demo("second.log"), 0) << readText(dir + "/second.log");
+  const std::string second = readText(dir + "/second.log");
+  EXPECT_NE(second.find("demo: reusing the rendered drive"), std::string::npos) << second;
+  EXPECT_EQ(second.find("demo: rendering"), std::string::npos) << second;
+  EXPECT_NE(second.find("Table I"), std::string::npos) << second;
+
+  writeScenario("seed: 2\n");  // a changed scenario renders again
+  ASSERT_EQ(demo("third.log"), 0) << readText(dir + "/third.log");
+  EXPECT_NE(readText(dir + "/third.log").find("demo: rendering 8 frames"), std::string::npos);
   std::system(("rm -rf " + dir).c_str());
 }

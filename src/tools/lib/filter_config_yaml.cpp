@@ -8,52 +8,64 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "config_yaml_detail.h"
+#include "online_stereo_calibration/tools/estimator_config_yaml.h"
+
 namespace osc {
 
-FilterConfig parseFilterConfigYaml(const std::string& text, const std::string& source_name,
-                                   const FilterConfig& base) {
+namespace detail {
+
+YAML::Node loadConfigMap(const std::string& text, const std::string& source_name) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(source_name + ": not valid YAML: " + e.what());
   }
-  FilterConfig config = base;
-  std::vector<std::string> problems;
   if (root && !root.IsNull() && !root.IsMap()) {
     throw std::runtime_error(source_name + ": expected a map of parameter: value");
   }
-  std::set<std::string> known = {"motion_noise_model"};
+  return root;
+}
+
+void readFilterKeys(const YAML::Node& root, FilterConfig* config, std::set<std::string>* known,
+                    std::vector<std::string>* problems) {
+  known->insert("motion_noise_model");
   for (const ParameterSpec& spec : filterParameterTable()) {
-    known.insert(spec.name);
+    known->insert(spec.name);
     const YAML::Node node = root[spec.name];
     if (!node) continue;
     try {
-      spec.set(&config, node.as<double>());
+      spec.set(config, node.as<double>());
     } catch (const YAML::Exception&) {
-      problems.push_back(spec.name + ": '" + YAML::Dump(node) + "' is not a number");
+      problems->push_back(spec.name + ": '" + YAML::Dump(node) + "' is not a number");
     }
   }
   if (const YAML::Node node = root["motion_noise_model"]) {
     try {
-      config.motion_noise_model = motionNoiseModelFromName(node.as<std::string>());
+      config->motion_noise_model = motionNoiseModelFromName(node.as<std::string>());
     } catch (const std::exception& e) {
-      problems.push_back(e.what());
+      problems->push_back(e.what());
     }
   }
-  if (root.IsMap()) {
-    for (const auto& entry : root) {
-      const std::string key = entry.first.as<std::string>();
-      if (!known.count(key)) problems.push_back(key + ": unknown parameter");
-    }
-  }
-  for (const std::string& p : config.validate()) problems.push_back(p);
-  if (!problems.empty()) {
-    std::string message = source_name + ": invalid configuration:";
-    for (const std::string& p : problems) message += "\n  " + p;
-    throw std::runtime_error(message);
-  }
-  return config;
+}
+
+void throwIfProblems(const std::string& source_name, const std::vector<std::string>& problems) {
+  if (problems.empty()) return;
+  std::string message = source_name + ": invalid configuration:";
+  for (const std::string& p : problems) message += "\n  " + p;
+  throw std::runtime_error(message);
+}
+
+}  // namespace detail
+
+FilterConfig parseFilterConfigYaml(const std::string& text, const std::string& source_name,
+                                   const FilterConfig& base) {
+  // The same file may carry the front end's section (estimator_config_yaml.h); it is checked
+  // too, so a file is either valid for every tool or refused by every tool.
+  EstimatorConfig estimator;
+  estimator.filter = base;
+  return parseEstimatorConfigYaml(text, source_name, estimator).filter;
 }
 
 FilterConfig readFilterConfigFile(const std::string& path, const FilterConfig& base) {

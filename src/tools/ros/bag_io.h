@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <map>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -181,6 +183,63 @@ inline std::string readScenarioFingerprint(const std::string& bag_path,
   } catch (const std::exception&) {
   }
   return "";
+}
+
+/// One topic of a bag: name, message type and number of messages.
+struct BagTopic {
+  std::string name, type;
+  std::size_t messages = 0;
+};
+
+/// Every topic of a bag, sorted by name.
+inline std::vector<BagTopic> listTopics(const rosbag::Bag& bag) {
+  std::map<std::string, BagTopic> topics;
+  rosbag::View all(bag);
+  for (const rosbag::ConnectionInfo* c : all.getConnections()) {
+    BagTopic& t = topics[c->topic];
+    t.name = c->topic;
+    t.type = c->datatype;
+  }
+  std::vector<BagTopic> out;
+  for (auto& [name, topic] : topics) {
+    topic.messages = rosbag::View(bag, rosbag::TopicQuery(name)).size();
+    out.push_back(topic);
+  }
+  return out;
+}
+
+/// A topic a tool needs: the option that sets it, its name and its message type.
+struct RequiredTopic {
+  std::string option;  ///< e.g. "--left-image"
+  std::string topic;   ///< e.g. "/stereo/left/image_raw"
+  std::string type;    ///< e.g. "sensor_msgs/Image"
+};
+
+/// Checks that every required topic has messages of its type in the bag.
+/// @throws std::runtime_error naming each missing or mistyped topic with its option, and
+/// listing the bag's topics (name, type, count).
+inline void requireTopics(const rosbag::Bag& bag, const std::string& bag_name,
+                          const std::vector<RequiredTopic>& required) {
+  const std::vector<BagTopic> topics = listTopics(bag);
+  std::string problems;
+  for (const RequiredTopic& r : required) {
+    const auto found = std::find_if(topics.begin(), topics.end(),
+                                    [&](const BagTopic& t) { return t.name == r.topic; });
+    if (found == topics.end() || found->messages == 0) {
+      problems += "\n  " + r.option + " " + r.topic + ": not in the bag";
+    } else if (found->type != r.type) {
+      problems += "\n  " + r.option + " " + r.topic + ": holds " + found->type + ", not " + r.type;
+    }
+  }
+  if (problems.empty()) return;
+  std::string message = bag_name +
+                        ": missing topics (set them with the options named):" + problems +
+                        "\nthe bag holds:";
+  if (topics.empty()) message += " no topics";
+  for (const BagTopic& t : topics) {
+    message += "\n  " + t.name + "  " + t.type + "  (" + std::to_string(t.messages) + " messages)";
+  }
+  throw std::runtime_error(message);
 }
 
 }  // namespace osc::bag

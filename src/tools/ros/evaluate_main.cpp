@@ -4,9 +4,12 @@
 ///
 ///   evaluate --bag DRIVE.bag --out DIR [--initial-guess GUESS.yaml] [--config PARAMS.yaml]
 ///            [--reference REF.yaml | --truth-topic TOPIC] [--window FIRST LAST]
+///            [--stereo-ns NS] [--left-image T] [--right-image T] [--left-info T]
+///            [--right-info T] [--odom T]
 ///
-/// Reads /stereo/{left,right}/image_raw and camera_info and /odom (poses interpolated to the
-/// image stamps, linear + SLERP), pairs the images by exact stamp and writes DIR/estimates.csv
+/// Reads NS/{left,right}/image_raw and camera_info (NS = /stereo) and /odom (poses interpolated
+/// to the image stamps, linear + SLERP), pairs the images by exact stamp and writes
+/// DIR/estimates.csv
 /// and DIR/calibration.yaml (the final estimate). With a reference also DIR/reference.csv,
 /// DIR/table.txt (Table I, consistency, convergence after a step, time per frame; also on
 /// stdout) and the plots of scripts/plot_convergence.py. Without --initial-guess the file
@@ -29,75 +32,88 @@
 #include <sensor_msgs/Image.h>
 
 #include "bag_io.h"
-#include "online_stereo_calibration/tools/output_directory.h"
 #include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
 #include "online_stereo_calibration/tools/bag_evaluation.h"
 #include "online_stereo_calibration/tools/calibration_file.h"
+#include "online_stereo_calibration/tools/command_line.h"
 #include "online_stereo_calibration/tools/estimates_csv.h"
+#include "online_stereo_calibration/tools/estimator_config_yaml.h"
 #include "online_stereo_calibration/tools/evaluation.h"
-#include "online_stereo_calibration/tools/filter_config_yaml.h"
+#include "online_stereo_calibration/tools/output_directory.h"
 
 namespace {
 
 struct Options {
   std::string bag, out, initial_guess, config, reference, truth_topic;
   int window_first = -1, window_last = -1;
+  int max_pairs = -1;  ///< stop after this many stereo pairs (-1: all)
+  /// Topics (interface.md: left/image_raw, ... relative to the stereo namespace, and odom).
+  std::string stereo_ns = "/stereo";
+  std::string left_image, right_image, left_info, right_info, odom = "/odom";
 };
 
 /// Odometry further than this (s) beyond an image stamp is not extrapolated.
 constexpr double kOdomTolerance = 0.02;
 
-void usage() {
-  std::cerr << "usage: evaluate --bag DRIVE.bag --out DIR [--initial-guess GUESS.yaml]\n"
-               "         [--config PARAMS.yaml] [--reference REF.yaml | --truth-topic TOPIC]\n"
-               "         [--window FIRST LAST]\n";
+/// The command line (`--help` prints it).
+osc::CommandLine commandLine(Options* o) {
+  osc::CommandLine cli(
+      "evaluate",
+      "Runs the calibration pipeline (front end + filter, as the nodelet) over a bag as fast as "
+      "possible,\nwithout a ROS master; writes DIR/estimates.csv and calibration.yaml, and with "
+      "a reference\nreference.csv, table.txt (Table I) and convergence plots.");
+  cli.option("--bag", &o->bag, "DRIVE.bag", "input bag").required();
+  cli.option("--out", &o->out, "DIR", "output directory").required();
+  cli.option("--initial-guess", &o->initial_guess, "GUESS.yaml",
+             "initial calibration (default: initial_guess.yaml beside the bag)");
+  cli.option("--config", &o->config, "PARAMS.yaml",
+             "estimator parameters: filter keys (config/default.yaml) and a front_end: map");
+  cli.option("--reference", &o->reference, "REF.yaml", "fixed true calibration");
+  cli.option("--truth-topic", &o->truth_topic, "TOPIC",
+             "per-frame truth (StereoCalibration), e.g. /ground_truth/calibration");
+  cli.option("--window", &o->window_first, &o->window_last, "FIRST LAST",
+             "frames of the Table I RMSE (default 1000 1150, clipped to the drive)")
+      .range(0, 1e9)
+      .defaultText("");
+  cli.option("--stereo-ns", &o->stereo_ns, "NS",
+             "namespace of left/ and right/ image_raw and camera_info");
+  cli.option("--left-image", &o->left_image, "TOPIC", "left images (default NS/left/image_raw)");
+  cli.option("--right-image", &o->right_image, "TOPIC",
+             "right images (default NS/right/image_raw)");
+  cli.option("--left-info", &o->left_info, "TOPIC",
+             "left CameraInfo (default NS/left/camera_info)");
+  cli.option("--right-info", &o->right_info, "TOPIC",
+             "right CameraInfo (default NS/right/camera_info)");
+  cli.option("--odom", &o->odom, "TOPIC", "vehicle odometry (nav_msgs/Odometry)");
+  cli.option("--frames", &o->max_pairs, "N", "evaluate only the first N stereo pairs")
+      .range(1, 1e9)
+      .defaultText("all");
+  return cli;
 }
 
-Options parse(int argc, char** argv) {
-  Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const auto value = [&](const char* name) -> std::string {
-      if (i + 1 >= argc) throw std::invalid_argument(std::string(name) + " needs a value");
-      return argv[++i];
-    };
-    if (a == "--bag")
-      o.bag = value("--bag");
-    else if (a == "--out")
-      o.out = value("--out");
-    else if (a == "--initial-guess")
-      o.initial_guess = value("--initial-guess");
-    else if (a == "--config")
-      o.config = value("--config");
-    else if (a == "--reference")
-      o.reference = value("--reference");
-    else if (a == "--truth-topic")
-      o.truth_topic = value("--truth-topic");
-    else if (a == "--window") {
-      o.window_first = std::stoi(value("--window"));
-      o.window_last = std::stoi(value("--window"));
-      if (o.window_first < 0 || o.window_last < o.window_first) {
-        throw std::invalid_argument("--window wants 0 <= FIRST <= LAST");
-      }
-    } else if (a == "--help" || a == "-h") {
-      usage();
-      std::exit(0);
-    } else {
-      throw std::invalid_argument("unknown argument '" + a + "'");
-    }
+/// Checks the option combinations and fills the topics left to the namespace.
+void finishOptions(Options* o) {
+  if (!o->reference.empty() && !o->truth_topic.empty()) {
+    throw osc::CommandLineError("give --reference or --truth-topic, not both");
   }
-  if (o.bag.empty() || o.out.empty()) throw std::invalid_argument("--bag and --out are required");
-  if (!o.reference.empty() && !o.truth_topic.empty()) {
-    throw std::invalid_argument("give --reference or --truth-topic, not both");
+  if (o->window_first >= 0 && o->window_last < o->window_first) {
+    throw osc::CommandLineError("--window wants FIRST <= LAST");
   }
-  return o;
+  std::string ns = o->stereo_ns;
+  while (!ns.empty() && ns.back() == '/') ns.pop_back();
+  const auto fill = [&](std::string* topic, const char* relative) {
+    if (topic->empty()) *topic = ns + "/" + relative;
+  };
+  fill(&o->left_image, "left/image_raw");
+  fill(&o->right_image, "right/image_raw");
+  fill(&o->left_info, "left/camera_info");
+  fill(&o->right_info, "right/camera_info");
 }
 
 bool isFile(const std::string& path) {
   struct stat st;
   return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
-
 
 std::string directoryOf(const std::string& path) {
   const auto slash = path.find_last_of('/');
@@ -143,214 +159,241 @@ osc::CameraIntrinsics readCameraInfo(const rosbag::Bag& bag, const std::string& 
 
 std::string quote(const std::string& s) { return "'" + s + "'"; }
 
+/// The tool itself, after the command line.
+int evaluateBag(const Options& options) {
+  osc::bag::DriveTopics topics;
+  topics.left_image = options.left_image;
+  topics.right_image = options.right_image;
+  topics.left_info = options.left_info;
+  topics.right_info = options.right_info;
+  topics.odom = options.odom;
+  std::string guess_path = options.initial_guess;
+  if (guess_path.empty()) guess_path = directoryOf(options.bag) + "/initial_guess.yaml";
+  if (!isFile(guess_path)) {
+    throw std::invalid_argument("no initial guess: give --initial-guess GUESS.yaml");
+  }
+  const osc::CalibrationFile guess = osc::readCalibrationFile(guess_path);
+  const osc::EstimatorConfig config = options.config.empty()
+                                          ? osc::EstimatorConfig()
+                                          : osc::readEstimatorConfigFile(options.config);
+
+  rosbag::Bag bag(options.bag, rosbag::bagmode::Read);
+  std::vector<osc::bag::RequiredTopic> required = {
+      {"--left-image", topics.left_image, "sensor_msgs/Image"},
+      {"--right-image", topics.right_image, "sensor_msgs/Image"},
+      {"--left-info", topics.left_info, "sensor_msgs/CameraInfo"},
+      {"--right-info", topics.right_info, "sensor_msgs/CameraInfo"},
+      {"--odom", topics.odom, "nav_msgs/Odometry"}};
+  if (!options.truth_topic.empty()) {
+    required.push_back(
+        {"--truth-topic", options.truth_topic, "online_stereo_calibration/StereoCalibration"});
+  }
+  osc::bag::requireTopics(bag, options.bag, required);
+  osc::makeDirectories(options.out);
+  const osc::CameraIntrinsics left_camera = readCameraInfo(bag, topics.left_info);
+  const osc::CameraIntrinsics right_camera = readCameraInfo(bag, topics.right_info);
+  const osc::PoseTrajectory odometry = osc::bag::readOdometry(bag, topics.odom);
+  if (odometry.size() < 2)
+    throw std::runtime_error("fewer than 2 odometry poses on " + topics.odom);
+  std::map<std::int64_t, osc::Vector12d> truth;
+  if (!options.truth_topic.empty()) {
+    for (const auto& [stamp, p] : osc::bag::readCalibrationTopic(bag, options.truth_topic)) {
+      truth[stamp] = p;
+    }
+    if (truth.empty()) throw std::runtime_error("no StereoCalibration on " + options.truth_topic);
+  }
+  const bool have_reference = !options.reference.empty() || !truth.empty();
+  osc::Vector12d constant_reference = osc::Vector12d::Zero();
+  if (!options.reference.empty()) {
+    constant_reference = osc::readCalibrationFile(options.reference).extrinsics.toParameters();
+  }
+
+  osc::CalibrationPipeline pipeline(config.filter, config.front_end, left_camera, right_camera,
+                                    guess.extrinsics);
+  int total = static_cast<int>(rosbag::View(bag, rosbag::TopicQuery(topics.left_image)).size());
+  if (options.max_pairs > 0) total = std::min(total, options.max_pairs);
+  std::cerr << "evaluating " << options.bag << ": " << total << " left images on "
+            << topics.left_image << ", " << odometry.size() << " odometry poses on " << topics.odom
+            << ", " << left_camera.width << "x" << left_camera.height << ", "
+            << config.front_end.detector << " front end\n";
+
+  osc::EstimatesCsvWriter estimates_csv(options.out + "/estimates.csv");
+  std::vector<osc::EstimateRow> estimates;
+  std::vector<osc::ReferenceRow> reference;
+  std::vector<double> times;
+  std::map<std::int64_t, sensor_msgs::ImageConstPtr> pending_left, pending_right;
+  int frame = 0, skipped = 0;
+  double previous_stamp = 0.0;
+  bool have_previous = false;
+  const auto start = std::chrono::steady_clock::now();
+  auto last_report = start;
+  // A terminal gets a progress bar redrawn twice a second; a log file a line every 10 s.
+  const bool terminal = isatty(STDERR_FILENO) != 0;
+  const auto report_every =
+      terminal ? std::chrono::milliseconds(500) : std::chrono::milliseconds(10000);
+  rosbag::View images(bag, rosbag::TopicQuery({topics.left_image, topics.right_image}));
+  for (const rosbag::MessageInstance& m : images) {
+    if (options.max_pairs > 0 && frame >= options.max_pairs) break;
+    const auto image = m.instantiate<sensor_msgs::Image>();
+    if (!image) continue;
+    const std::int64_t key = static_cast<std::int64_t>(image->header.stamp.toNSec());
+    const bool is_left = m.getTopic() == topics.left_image;
+    auto& mine = is_left ? pending_left : pending_right;
+    auto& other = is_left ? pending_right : pending_left;
+    const auto match = other.find(key);
+    if (match == other.end()) {
+      mine[key] = image;
+      continue;
+    }
+    const sensor_msgs::ImageConstPtr left = is_left ? image : match->second;
+    const sensor_msgs::ImageConstPtr right = is_left ? match->second : image;
+    other.erase(other.begin(), std::next(match));  // older unmatched images never pair now
+    mine.erase(mine.begin(), mine.lower_bound(key));
+
+    const double stamp = left->header.stamp.toSec();
+    osc::MotionIncrement motion;
+    if (have_previous) {
+      const auto increment = odometry.motionBetween(previous_stamp, stamp, kOdomTolerance);
+      if (increment) {
+        motion = *increment;
+      } else {
+        std::cerr << "\nevaluate: no odometry around pair " << frame << " (stamp " << stamp
+                  << "); tracking restarts\n";
+        pipeline.resetTracking();
+      }
+    }
+    cv_bridge::CvImageConstPtr left_holder, right_holder;
+    const osc::PipelineResult result =
+        pipeline.process(toMat(left, &left_holder), toMat(right, &right_holder), motion);
+    if (!result.processed) {
+      std::cerr << "\nevaluate: pair " << frame << " not used: " << result.status << "\n";
+      ++skipped;
+      ++frame;
+      continue;
+    }
+    previous_stamp = stamp;
+    have_previous = true;
+    osc::EstimateRow row;
+    row.frame = frame;
+    row.stamp = stamp;
+    row.parameters = result.estimate.parameters;
+    row.sigmas = result.estimate.sigmas();
+    row.tracked_points = static_cast<int>(result.estimate.tracked_points);
+    row.time_ms = 1000.0 * result.processing_time;
+    estimates_csv.write(row);
+    estimates.push_back(row);
+    times.push_back(row.time_ms);
+    if (have_reference) {
+      osc::ReferenceRow ref;
+      ref.frame = frame;
+      ref.stamp = stamp;
+      ref.parameters = constant_reference;
+      const auto t = truth.find(key);
+      if (truth.empty() || t != truth.end()) {
+        if (t != truth.end()) ref.parameters = t->second;
+        reference.push_back(ref);
+      }
+    }
+    ++frame;
+    const auto now = std::chrono::steady_clock::now();
+    if (frame == total || now - last_report > report_every) {
+      last_report = now;
+      std::cerr << (terminal ? "\r  " : "  ")
+                << osc::progressLine(frame, total,
+                                     std::chrono::duration<double>(now - start).count())
+                << "  points " << row.tracked_points << (terminal ? "" : "\n") << std::flush;
+    }
+  }
+  if (terminal) std::cerr << "\n";
+  estimates_csv.flush();
+  if (estimates.empty()) throw std::runtime_error("no stereo pair was processed");
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  osc::CalibrationFile final_calibration;
+  final_calibration.extrinsics = osc::StereoExtrinsics::fromParameters(estimates.back().parameters);
+  final_calibration.sigmas = estimates.back().sigmas;
+  final_calibration.stamp = estimates.back().stamp;
+  osc::writeCalibrationFileAtomic(options.out + "/calibration.yaml", final_calibration);
+
+  const osc::Percentiles timing = osc::percentiles(times);
+  std::ostringstream text;
+  int step_frame = -1;
+  if (!reference.empty()) {
+    osc::ReferenceCsvWriter reference_csv(options.out + "/reference.csv");
+    for (const osc::ReferenceRow& r : reference) reference_csv.write(r);
+    reference_csv.flush();
+    const int last_frame = estimates.back().frame;
+    int last = options.window_last >= 0 ? options.window_last : std::min(1150, last_frame);
+    int first =
+        options.window_first >= 0 ? options.window_first : std::min(1000, std::max(0, last - 150));
+    const osc::EvaluationReport report = osc::evaluateWindow(estimates, reference, first, last);
+    text << "Bag " << options.bag << ", RMSE over frames " << first << "-" << last << " ("
+         << report.frames_used << " frames used):\n"
+         << osc::formatTableI(report) << "\n";
+    double within = 0;
+    for (const auto& p : report.parameters) within += p.within_2sigma / 12.0;
+    text << "Consistency: " << 100.0 * within << " % of errors within 2 sigma (95.4 % if "
+         << "consistent), mean NEES " << report.mean_nees << " (1 if consistent)\n";
+    step_frame = osc::detectStepFrame(reference);
+    if (step_frame >= 0) {
+      int stepped = 0;
+      double largest = 0;
+      const auto& before =
+          std::find_if(reference.begin(), reference.end(),
+                       [&](const osc::ReferenceRow& r) { return r.frame == step_frame; });
+      for (int p = 0; p < 12 && before != reference.begin(); ++p) {
+        const double d = std::abs((before->parameters(p) - (before - 1)->parameters(p)) *
+                                  (p % 6 >= 3 ? 1.0 : 0.1));
+        if (d > largest) largest = d, stepped = p;
+      }
+      const double tolerance = stepped % 6 >= 3 ? 0.3 * M_PI / 180.0 : 0.03;
+      const int back = osc::framesToConverge(estimates, reference, stepped, tolerance, step_frame);
+      text << "Step at frame " << step_frame << " (largest in "
+           << osc::estimatesCsvColumns()[2 + stepped] << "): within "
+           << (stepped % 6 >= 3 ? "0.3 deg" : "3 cm") << " from frame " << back << " on ("
+           << (back >= 0 ? back - step_frame : -1) << " frames to converge)\n";
+    }
+  } else {
+    const osc::EstimateRow& last = estimates.back();
+    text << "Bag " << options.bag << " (no reference): final estimate and 1 sigma\n";
+    for (int p = 0; p < 12; ++p) {
+      text << "  " << osc::estimatesCsvColumns()[2 + p] << " = " << last.parameters(p) << " +- "
+           << last.sigmas(p) << "\n";
+    }
+  }
+  text << "Pairs processed: " << estimates.size() << ", not used: " << skipped
+       << "; time per frame: median " << timing.median << " ms, p95 " << timing.p95 << " ms; total "
+       << elapsed << " s (" << estimates.size() / elapsed << " frames/s)\n";
+  std::cout << text.str();
+  std::ofstream(options.out + "/table.txt") << text.str();
+
+  const std::string script = findPlotScript();
+  if (script.empty()) {
+    std::cerr << "evaluate: warning: scripts/plot_convergence.py not found (set "
+                 "OSC_PLOT_SCRIPT); no plots\n";
+  } else {
+    std::string command = "/usr/bin/python3 " + quote(script) + " --out " + quote(options.out);
+    if (step_frame >= 0) command += " --step-frame " + std::to_string(step_frame);
+    if (std::system(command.c_str()) != 0) {
+      std::cerr << "evaluate: warning: the plots failed (" << command << ")\n";
+    }
+  }
+  std::cout << "wrote " << options.out << "/estimates.csv, calibration.yaml, table.txt"
+            << (reference.empty() ? "" : ", reference.csv") << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    const Options options = parse(argc, argv);
-    const osc::bag::DriveTopics topics;
-    std::string guess_path = options.initial_guess;
-    if (guess_path.empty()) guess_path = directoryOf(options.bag) + "/initial_guess.yaml";
-    if (!isFile(guess_path)) {
-      throw std::invalid_argument("no initial guess: give --initial-guess GUESS.yaml");
-    }
-    const osc::CalibrationFile guess = osc::readCalibrationFile(guess_path);
-    const osc::FilterConfig config =
-        options.config.empty() ? osc::FilterConfig() : osc::readFilterConfigFile(options.config);
-    osc::makeDirectories(options.out);
-
-    rosbag::Bag bag(options.bag, rosbag::bagmode::Read);
-    const osc::CameraIntrinsics left_camera = readCameraInfo(bag, topics.left_info);
-    const osc::CameraIntrinsics right_camera = readCameraInfo(bag, topics.right_info);
-    const osc::PoseTrajectory odometry = osc::bag::readOdometry(bag, topics.odom);
-    if (odometry.size() < 2)
-      throw std::runtime_error("fewer than 2 odometry poses on " + topics.odom);
-    std::map<std::int64_t, osc::Vector12d> truth;
-    if (!options.truth_topic.empty()) {
-      for (const auto& [stamp, p] : osc::bag::readCalibrationTopic(bag, options.truth_topic)) {
-        truth[stamp] = p;
-      }
-      if (truth.empty()) throw std::runtime_error("no StereoCalibration on " + options.truth_topic);
-    }
-    const bool have_reference = !options.reference.empty() || !truth.empty();
-    osc::Vector12d constant_reference = osc::Vector12d::Zero();
-    if (!options.reference.empty()) {
-      constant_reference = osc::readCalibrationFile(options.reference).extrinsics.toParameters();
-    }
-
-    osc::CalibrationPipeline pipeline(config, osc::FrontEndConfig(), left_camera, right_camera,
-                                      guess.extrinsics);
-    const int total =
-        static_cast<int>(rosbag::View(bag, rosbag::TopicQuery(topics.left_image)).size());
-    std::cerr << "evaluating " << options.bag << ": " << total << " left images, "
-              << odometry.size() << " odometry poses, " << left_camera.width << "x"
-              << left_camera.height << "\n";
-
-    osc::EstimatesCsvWriter estimates_csv(options.out + "/estimates.csv");
-    std::vector<osc::EstimateRow> estimates;
-    std::vector<osc::ReferenceRow> reference;
-    std::vector<double> times;
-    std::map<std::int64_t, sensor_msgs::ImageConstPtr> pending_left, pending_right;
-    int frame = 0, skipped = 0;
-    double previous_stamp = 0.0;
-    bool have_previous = false;
-    const auto start = std::chrono::steady_clock::now();
-    auto last_report = start;
-    rosbag::View images(bag, rosbag::TopicQuery({topics.left_image, topics.right_image}));
-    for (const rosbag::MessageInstance& m : images) {
-      const auto image = m.instantiate<sensor_msgs::Image>();
-      if (!image) continue;
-      const std::int64_t key = static_cast<std::int64_t>(image->header.stamp.toNSec());
-      const bool is_left = m.getTopic() == topics.left_image;
-      auto& mine = is_left ? pending_left : pending_right;
-      auto& other = is_left ? pending_right : pending_left;
-      const auto match = other.find(key);
-      if (match == other.end()) {
-        mine[key] = image;
-        continue;
-      }
-      const sensor_msgs::ImageConstPtr left = is_left ? image : match->second;
-      const sensor_msgs::ImageConstPtr right = is_left ? match->second : image;
-      other.erase(other.begin(), std::next(match));  // older unmatched images never pair now
-      mine.erase(mine.begin(), mine.lower_bound(key));
-
-      const double stamp = left->header.stamp.toSec();
-      osc::MotionIncrement motion;
-      if (have_previous) {
-        const auto increment = odometry.motionBetween(previous_stamp, stamp, kOdomTolerance);
-        if (increment) {
-          motion = *increment;
-        } else {
-          std::cerr << "\nevaluate: no odometry around pair " << frame << " (stamp " << stamp
-                    << "); tracking restarts\n";
-          pipeline.resetTracking();
-        }
-      }
-      cv_bridge::CvImageConstPtr left_holder, right_holder;
-      const osc::PipelineResult result =
-          pipeline.process(toMat(left, &left_holder), toMat(right, &right_holder), motion);
-      if (!result.processed) {
-        std::cerr << "\nevaluate: pair " << frame << " not used: " << result.status << "\n";
-        ++skipped;
-        ++frame;
-        continue;
-      }
-      previous_stamp = stamp;
-      have_previous = true;
-      osc::EstimateRow row;
-      row.frame = frame;
-      row.stamp = stamp;
-      row.parameters = result.estimate.parameters;
-      row.sigmas = result.estimate.sigmas();
-      row.tracked_points = static_cast<int>(result.estimate.tracked_points);
-      row.time_ms = 1000.0 * result.processing_time;
-      estimates_csv.write(row);
-      estimates.push_back(row);
-      times.push_back(row.time_ms);
-      if (have_reference) {
-        osc::ReferenceRow ref;
-        ref.frame = frame;
-        ref.stamp = stamp;
-        ref.parameters = constant_reference;
-        const auto t = truth.find(key);
-        if (truth.empty() || t != truth.end()) {
-          if (t != truth.end()) ref.parameters = t->second;
-          reference.push_back(ref);
-        }
-      }
-      ++frame;
-      const auto now = std::chrono::steady_clock::now();
-      if (frame == total || now - last_report > std::chrono::milliseconds(500)) {
-        last_report = now;
-        std::cerr << "\r  "
-                  << osc::progressLine(frame, total,
-                                       std::chrono::duration<double>(now - start).count())
-                  << "  points " << row.tracked_points << std::flush;
-      }
-    }
-    std::cerr << "\n";
-    estimates_csv.flush();
-    if (estimates.empty()) throw std::runtime_error("no stereo pair was processed");
-    const double elapsed =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-    osc::CalibrationFile final_calibration;
-    final_calibration.extrinsics =
-        osc::StereoExtrinsics::fromParameters(estimates.back().parameters);
-    final_calibration.sigmas = estimates.back().sigmas;
-    final_calibration.stamp = estimates.back().stamp;
-    osc::writeCalibrationFileAtomic(options.out + "/calibration.yaml", final_calibration);
-
-    const osc::Percentiles timing = osc::percentiles(times);
-    std::ostringstream text;
-    int step_frame = -1;
-    if (!reference.empty()) {
-      osc::ReferenceCsvWriter reference_csv(options.out + "/reference.csv");
-      for (const osc::ReferenceRow& r : reference) reference_csv.write(r);
-      reference_csv.flush();
-      const int last_frame = estimates.back().frame;
-      int last = options.window_last >= 0 ? options.window_last : std::min(1150, last_frame);
-      int first = options.window_first >= 0 ? options.window_first
-                                            : std::min(1000, std::max(0, last - 150));
-      const osc::EvaluationReport report = osc::evaluateWindow(estimates, reference, first, last);
-      text << "Bag " << options.bag << ", RMSE over frames " << first << "-" << last << " ("
-           << report.frames_used << " frames used):\n"
-           << osc::formatTableI(report) << "\n";
-      double within = 0;
-      for (const auto& p : report.parameters) within += p.within_2sigma / 12.0;
-      text << "Consistency: " << 100.0 * within << " % of errors within 2 sigma (95.4 % if "
-           << "consistent), mean NEES " << report.mean_nees << " (1 if consistent)\n";
-      step_frame = osc::detectStepFrame(reference);
-      if (step_frame >= 0) {
-        int stepped = 0;
-        double largest = 0;
-        const auto& before =
-            std::find_if(reference.begin(), reference.end(),
-                         [&](const osc::ReferenceRow& r) { return r.frame == step_frame; });
-        for (int p = 0; p < 12 && before != reference.begin(); ++p) {
-          const double d = std::abs((before->parameters(p) - (before - 1)->parameters(p)) *
-                                    (p % 6 >= 3 ? 1.0 : 0.1));
-          if (d > largest) largest = d, stepped = p;
-        }
-        const double tolerance = stepped % 6 >= 3 ? 0.3 * M_PI / 180.0 : 0.03;
-        const int back =
-            osc::framesToConverge(estimates, reference, stepped, tolerance, step_frame);
-        text << "Step at frame " << step_frame << " (largest in "
-             << osc::estimatesCsvColumns()[2 + stepped] << "): within "
-             << (stepped % 6 >= 3 ? "0.3 deg" : "3 cm") << " from frame " << back << " on ("
-             << (back >= 0 ? back - step_frame : -1) << " frames to converge)\n";
-      }
-    } else {
-      const osc::EstimateRow& last = estimates.back();
-      text << "Bag " << options.bag << " (no reference): final estimate and 1 sigma\n";
-      for (int p = 0; p < 12; ++p) {
-        text << "  " << osc::estimatesCsvColumns()[2 + p] << " = " << last.parameters(p) << " +- "
-             << last.sigmas(p) << "\n";
-      }
-    }
-    text << "Pairs processed: " << estimates.size() << ", not used: " << skipped
-         << "; time per frame: median " << timing.median << " ms, p95 " << timing.p95
-         << " ms; total " << elapsed << " s (" << estimates.size() / elapsed << " frames/s)\n";
-    std::cout << text.str();
-    std::ofstream(options.out + "/table.txt") << text.str();
-
-    const std::string script = findPlotScript();
-    if (script.empty()) {
-      std::cerr << "evaluate: warning: scripts/plot_convergence.py not found (set "
-                   "OSC_PLOT_SCRIPT); no plots\n";
-    } else {
-      std::string command = "/usr/bin/python3 " + quote(script) + " --out " + quote(options.out);
-      if (step_frame >= 0) command += " --step-frame " + std::to_string(step_frame);
-      if (std::system(command.c_str()) != 0) {
-        std::cerr << "evaluate: warning: the plots failed (" << command << ")\n";
-      }
-    }
-    std::cout << "wrote " << options.out << "/estimates.csv, calibration.yaml, table.txt"
-              << (reference.empty() ? "" : ", reference.csv") << "\n";
-    return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "evaluate: " << e.what() << "\n";
-    usage();
-    return 1;
-  }
+  Options parsed;
+  osc::CommandLine cli = commandLine(&parsed);
+  return osc::runTool(
+      "evaluate", [&] { return cli.usage(); },
+      [&] {
+        if (!cli.parse(argc, argv)) return 0;
+        finishOptions(&parsed);
+        return evaluateBag(parsed);
+      });
 }

@@ -1,0 +1,55 @@
+/// @file estimator_config_yaml.h
+/// @brief The estimator's whole configuration from one YAML file: the filter's keys
+/// (FilterConfig, config/default.yaml) at the top level and the image front end's
+/// (FrontEndConfig, the same names as its fields) in a `front_end:` map, the layout the
+/// nodelet reads from its private namespace (`~front_end/...`, config/ros.yaml):
+///
+///   pixel_noise_px: 0.5        # FilterConfig (filterParameterTable names)
+///   front_end:                 # FrontEndConfig field names
+///     detector: FAST_ORB
+///     max_features: 1500
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "online_stereo_calibration/core/config/filter_config.h"
+#include "online_stereo_calibration/core/frontend/front_end_config.h"
+
+namespace osc {
+
+/// Filter and front-end configuration of a CalibrationPipeline.
+struct EstimatorConfig {
+  FilterConfig filter;
+  FrontEndConfig front_end;
+};
+
+/// One key of FrontEndConfig (for reading, writing and the docs).
+struct FrontEndKey {
+  enum class Type { kInteger, kReal, kString };
+  std::string name;  ///< field name = YAML key under front_end:
+  Type type = Type::kReal;
+  int FrontEndConfig::*integer_field = nullptr;
+  double FrontEndConfig::*real_field = nullptr;
+  std::string FrontEndConfig::*string_field = nullptr;
+};
+
+/// Every field of FrontEndConfig, in declaration order.
+const std::vector<FrontEndKey>& frontEndKeyTable();
+
+/// Reads the filter keys (top level) and the front-end keys (under `front_end:`); keys not
+/// given keep the value of @p base. Unknown keys (at either level), values of the wrong type
+/// and values out of range (FilterConfig::validate, FrontEndConfig::validate) are errors:
+/// throws std::runtime_error naming @p source_name and listing every problem, front-end ones
+/// as `front_end.KEY`.
+EstimatorConfig parseEstimatorConfigYaml(const std::string& text, const std::string& source_name,
+                                         const EstimatorConfig& base = EstimatorConfig());
+
+/// Reads a YAML file (see parseEstimatorConfigYaml). Throws std::runtime_error naming the file.
+EstimatorConfig readEstimatorConfigFile(const std::string& path,
+                                        const EstimatorConfig& base = EstimatorConfig());
+
+/// The `front_end:` section of a loadable file: every key with its value.
+std::string formatFrontEndConfigYaml(const FrontEndConfig& config);
+
+}  // namespace osc
