@@ -12,10 +12,12 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
 
 #include "../../src/tools/ros/bag_io.h"
 #include "online_stereo_calibration/tools/bag_evaluation.h"
 #include "online_stereo_calibration/tools/calibration_file.h"
+#include "online_stereo_calibration/tools/drive_simulation.h"
 #include "online_stereo_calibration/tools/estimates_csv.h"
 #include "online_stereo_calibration/tools/pose_interpolation.h"
 #include "online_stereo_calibration/tools/scenario_file.h"
@@ -155,6 +157,22 @@ TEST(ScenarioFile, ErrorsNameTheKey) {
   EXPECT_NE(message("frames: -3\n").find("frames"), std::string::npos);
   EXPECT_NE(message("left_camera: {distortion_model: wavy}\n").find("left_camera.distortion_model"),
             std::string::npos);
+}
+
+TEST(DriveSimulation, AShortenedDriveIsTheBeginningOfTheFullOne) {
+  // simulate --frames N (and scripts/demo.sh) render the first N frames of the same scene.
+  const osc::SimulationScenario scenario = osc::parseScenarioYaml(
+      "base: paper_offroad\nframes: 300\n"
+      "left_camera: {width: 160, height: 120, fx: 150, fy: 150, cx: 79.5, cy: 59.5}\n"
+      "right_camera: {width: 160, height: 120, fx: 150, fy: 150, cx: 79.5, cy: 59.5}\n"
+      "rendering: {supersampling: 1}\n",
+      "short.yaml", ".");
+  const osc::DriveSimulator shortened(scenario, 5), full(scenario);
+  const osc::SimulatedImagePair a = shortened.renderFrame(4), b = full.renderFrame(4);
+  EXPECT_EQ(cv::norm(a.left, b.left, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(a.right, b.right, cv::NORM_INF), 0.0);
+  EXPECT_TRUE(a.truth.isApprox(b.truth, 0.0));
+  EXPECT_NE(osc::scenarioFingerprint(scenario, 5), osc::scenarioFingerprint(scenario, 300));
 }
 
 TEST(BagTools, SimulateThenEvaluateShortDrive) {
@@ -333,7 +351,7 @@ TEST(BagTools, DemoScriptCachesTheRenderedDrive) {
   const std::string dir = mkdtemp(dir_template);
   const auto writeScenario = [&](const std::string& extra) {
     std::ofstream scenario(dir + "/tiny.yaml");
-    scenario << "base: paper_offroad\nname: tiny\nframes: 1500\n"
+    scenario << "base: paper_offroad\nname: tiny\nframes: 20\n"
                 "left_camera: {width: 240, height: 180, fx: 220, fy: 220, cx: 119.5, cy: 89.5}\n"
                 "right_camera: {width: 240, height: 180, fx: 220, fy: 220, cx: 119.5, cy: 89.5}\n"
                 "rendering: {supersampling: 1}\n"

@@ -2,6 +2,7 @@
 /// @brief The image-level simulated drive (see drive_simulation.h).
 #include "online_stereo_calibration/tools/drive_simulation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -41,9 +42,18 @@ DriveSimulator::DriveSimulator(const SimulationScenario& scenario, int frames)
   scene.seed = scenario_.rendering.scene_seed;
   scene.ground_undulation = scenario_.rendering.ground_undulation;
   scene.structure_density = scenario_.rendering.structure_density;
+  // The scene is laid along the scenario's whole drive, not only the frames rendered: a drive
+  // cut short with `frames` is then the beginning of the full one (same structures), which is
+  // what scripts/demo.sh and `simulate --frames` promise.
+  const int scenario_frames = std::max(frames_, scenario.measurement.frames);
+  double scene_duration = (scenario_frames - 1) / scenario_.measurement.rate_hz +
+                          2.0 / scenario_.rendering.odom_rate_hz;
+  if (scenario_.trajectory) {
+    scene_duration = std::min(scene_duration, recorded_.lastStamp() - recorded_start_);
+  }
   Eigen::Vector2d last = truePose(0.0).translation().head<2>();
   scene.path.push_back(last);
-  for (double t = 0.0; t <= duration; t += 0.05) {
+  for (double t = 0.0; t <= scene_duration; t += 0.05) {
     const Eigen::Vector2d p = truePose(t).translation().head<2>();
     if ((p - last).norm() >= kPathSpacing) {
       scene.path.push_back(p);

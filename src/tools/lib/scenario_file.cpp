@@ -16,7 +16,7 @@ namespace osc {
 namespace {
 
 /// Version of the simulator's output; part of the cache fingerprint.
-constexpr const char* kSimulatorVersion = "simulate-1";
+constexpr const char* kSimulatorVersion = "simulate-2";  // 2: scene along the whole drive
 
 /// Collects problems instead of stopping at the first.
 struct Problems {
