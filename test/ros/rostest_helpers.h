@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -77,6 +78,17 @@ class DiagnosticsCollector {
       }
     }
     return false;
+  }
+  /// Largest value of key @p key read as a number (-1 if never seen).
+  double maxValue(const std::string& key) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    double largest = -1.0;
+    for (const auto& s : statuses_) {
+      for (const auto& kv : s.values) {
+        if (kv.key == key) largest = std::max(largest, std::atof(kv.value.c_str()));
+      }
+    }
+    return largest;
   }
   /// Index of the next status to arrive (to look only at later ones).
   size_t mark() const {
