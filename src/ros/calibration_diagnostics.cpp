@@ -75,16 +75,22 @@ void CalibrationDiagnostics::setInitialGuess(const std::string& description) {
 }
 
 void CalibrationDiagnostics::recordProblem(const std::string& kind, const std::string& message) {
+  constexpr size_t kMaxUnreported = 3;
   std::lock_guard<std::mutex> lock(mutex_);
   last_problem_ = message;
   for (Problem& problem : problems_) {
     if (problem.kind == kind) {
       ++problem.count;
       problem.last_message = message;
+      if (problem.unreported.size() < kMaxUnreported &&
+          std::find(problem.unreported.begin(), problem.unreported.end(), message) ==
+              problem.unreported.end()) {
+        problem.unreported.push_back(message);
+      }
       return;
     }
   }
-  problems_.push_back({kind, 1, message});
+  problems_.push_back({kind, 1, message, {message}});
 }
 
 int CalibrationDiagnostics::count(const std::string& kind) const {
@@ -176,9 +182,14 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
   // Problems since the last report make the status WARN; totals are always listed.
   counts_at_last_report_.resize(problems_.size());
   for (size_t i = 0; i < problems_.size(); ++i) {
-    const Problem& problem = problems_[i];
+    Problem& problem = problems_[i];
     status.add(problem.kind + " (total)", problem.count);
-    status.add(problem.kind + " (last)", problem.last_message);
+    // Every distinct message since the previous report (the latest alone if none is new).
+    std::string recent;
+    for (const std::string& message : problem.unreported)
+      recent += (recent.empty() ? "" : " | ") + message;
+    status.add(problem.kind + " (last)", recent.empty() ? problem.last_message : recent);
+    problem.unreported.clear();
     std::pair<std::string, int>& old = counts_at_last_report_[i];
     if (old.first != problem.kind) old = {problem.kind, 0};  // problems_ only grows
     if (problem.count > old.second) {

@@ -43,11 +43,13 @@ class CalibrationDiagnostics {
  private:
   void produceStatus(diagnostic_updater::DiagnosticStatusWrapper& status);
 
-  /// One kind of problem: how often, and the latest message.
+  /// One kind of problem: how often, the latest message, and the distinct messages since
+  /// the last report (so that two problems between two 1 Hz reports are both shown).
   struct Problem {
     std::string kind;
     int count = 0;
     std::string last_message;
+    std::vector<std::string> unreported;
   };
   /// Counts of single inputs (index: left image, right image, left info, right info).
   struct InputCounts {
