@@ -55,6 +55,7 @@ std::vector<std::string> FrontEndConfig::validate() const {
   checkRange(&p, "max_track_window", max_track_window, min_track_window, 500.0);
   checkRange(&p, "max_track_descriptor_distance", max_track_descriptor_distance, 0.0, 1.0, true);
   checkRange(&p, "track_ratio", track_ratio, 0.0, 1.0, true);
+  checkRange(&p, "reacquire_below_fraction", reacquire_below_fraction, 0.0, 1.0, false);
   checkRange(&p, "track_gate_chi2_2dof", track_gate_chi2_2dof, 0.0, 1000.0, true);
   checkRange(&p, "min_image_size", min_image_size, 8, 10000);
   checkRange(&p, "min_contrast", min_contrast, 0.0, 100.0);

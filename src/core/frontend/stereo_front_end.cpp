@@ -126,8 +126,9 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   if (tracker_.size() > 0 && filter.pointCount() > 0) {
     last_windows_ =
         tracker_.windows(filter.predictObservations(motion), left_camera_, right_camera_);
-    const std::vector<TrackMatch> found =
+    std::vector<TrackMatch> found =
         tracker_.track(last_windows_, left, right, &left_used, &right_used, on_band);
+    reacquireLostTracks(left, right, on_band, &left_used, &right_used, &found);
     // Sub-pixel: the point's patch in the previous left image is aligned into this one from
     // the keypoint found (so the track stays on the same surface point instead of following
     // the detector's pixel-grid jitter), then into the right image.
@@ -304,6 +305,38 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   stats.new_candidates = static_cast<int>(last_new_.size());
   if (statistics) *statistics = stats;
   return observations;
+}
+
+void StereoFrontEnd::reacquireLostTracks(const FeatureSet& left, const FeatureSet& right,
+                                         const std::function<bool(int, int)>& consistent,
+                                         std::vector<char>* left_used,
+                                         std::vector<char>* right_used,
+                                         std::vector<TrackMatch>* found) {
+  constexpr size_t kMinTracks = 10;
+  const size_t expected = last_windows_.size();
+  if (config_.reacquire_below_fraction <= 0.0 || expected < kMinTracks ||
+      found->size() >= config_.reacquire_below_fraction * expected) {
+    return;
+  }
+  std::unordered_set<PointId> tracked;
+  for (const TrackMatch& m : *found) tracked.insert(m.id);
+  // The whole image as the window; the gate widened by the image diagonal so that only the
+  // descriptor (with its ratio test) and the epipolar band decide.
+  const CameraIntrinsics& in = left_camera_.intrinsics();
+  const Eigen::Vector2d half(0.5 * in.width, 0.5 * in.height);
+  const double diagonal2 = 4.0 * half.squaredNorm();
+  std::vector<TrackWindow> everywhere;
+  for (const TrackWindow& w : last_windows_) {
+    if (tracked.count(w.id)) continue;
+    TrackWindow wide = w;
+    wide.left_center = wide.right_center = half;
+    wide.left_half = wide.right_half = half;
+    wide.S.diagonal().array() += diagonal2;
+    everywhere.push_back(wide);
+  }
+  const std::vector<TrackMatch> more =
+      tracker_.track(everywhere, left, right, left_used, right_used, consistent);
+  found->insert(found->end(), more.begin(), more.end());
 }
 
 StereoFrontEnd::EpipolarBand StereoFrontEnd::bandPolylines(const Eigen::Vector2d& left_und,

@@ -102,6 +102,12 @@ struct FrontEndConfig {
   /// Gate on the squared Mahalanobis distance (2 dof, under the filter's S) of a track's
   /// keypoint from its predicted pixel in each image (13.8 = 99.9 %), (0, 1000].
   double track_gate_chi2_2dof = 13.8;
+  /// When fewer than this fraction of (at least 10) tracks is found in their windows, the
+  /// lost ones are searched over the whole image by descriptor: after a sudden change of the
+  /// calibration (a knocked camera) the points are far from their predictions, and found
+  /// there they reach the filter as outliers, from which it detects the change. [0, 1];
+  /// 0 = off.
+  double reacquire_below_fraction = 0.5;
 
   // --- input checks ---
   /// Least image size (px, each axis) accepted, [8, 10000].

@@ -4,6 +4,7 @@
 /// matching of new points -> bucketing; then the estimator's report closes the frame.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -82,6 +83,13 @@ class StereoFrontEnd {
   };
   EpipolarBand bandPolylines(const Eigen::Vector2d& left_undistorted,
                              const Eigen::Vector2d& right_undistorted) const;
+  /// After a sudden change most tracks are far from their windows: when fewer than
+  /// reacquire_below_fraction of them were found, the lost ones are searched over the whole
+  /// image by descriptor and appended to *found (the filter then gates them as outliers).
+  void reacquireLostTracks(const FeatureSet& left, const FeatureSet& right,
+                           const std::function<bool(int, int)>& consistent,
+                           std::vector<char>* left_used, std::vector<char>* right_used,
+                           std::vector<TrackMatch>* found);
 
   struct Pending {
     PointId id;
