@@ -197,30 +197,56 @@ osc::FrontEndConfig loadFrontEndConfig(const ros::NodeHandle& nh,
                                        std::vector<std::string>* problems) {
   osc::FrontEndConfig config;
   const ros::NodeHandle fe(nh, "front_end");
-  readString(fe, "detector", &config.detector, problems);
-  readInt(fe, "max_features", &config.max_features, problems);
-  readInt(fe, "fast_threshold", &config.fast_threshold, problems);
-  readInt(fe, "orb_levels", &config.orb_levels, problems);
-  readNumber(fe, "orb_scale_factor", &config.orb_scale_factor, problems);
-  readInt(fe, "detection_grid", &config.detection_grid, problems);
-  readNumber(fe, "border", &config.border, problems);
-  readNumber(fe, "band_sigmas", &config.band_sigmas, problems);
-  readNumber(fe, "min_band", &config.min_band, problems);
-  readNumber(fe, "max_band", &config.max_band, problems);
-  readNumber(fe, "pixel_sigma", &config.pixel_sigma, problems);
-  readNumber(fe, "max_descriptor_distance", &config.max_descriptor_distance, problems);
-  readNumber(fe, "ratio", &config.ratio, problems);
-  readInt(fe, "bucket_cols", &config.bucket_cols, problems);
-  readInt(fe, "bucket_rows", &config.bucket_rows, problems);
-  readInt(fe, "max_new_points_per_frame", &config.max_new_points_per_frame, problems);
-  readNumber(fe, "min_distance_to_track", &config.min_distance_to_track, problems);
-  readNumber(fe, "min_parallax_deg", &config.min_parallax_deg, problems);
-  readNumber(fe, "track_window_sigmas", &config.track_window_sigmas, problems);
-  readNumber(fe, "min_track_window", &config.min_track_window, problems);
-  readNumber(fe, "max_track_window", &config.max_track_window, problems);
-  readNumber(fe, "max_track_descriptor_distance", &config.max_track_descriptor_distance, problems);
-  readInt(fe, "min_image_size", &config.min_image_size, problems);
-  readNumber(fe, "min_contrast", &config.min_contrast, problems);
+  // Every key of frontEndParameterTable(), as ~front_end/<name>.
+  using Type = osc::FrontEndParameterSpec::Type;
+  for (const osc::FrontEndParameterSpec& spec : osc::frontEndParameterTable()) {
+    XmlRpc::XmlRpcValue value;
+    if (!fe.getParam(spec.name, value)) continue;
+    const std::string key = "front_end/" + spec.name;
+    switch (spec.type) {
+      case Type::kString:
+        if (value.getType() != XmlRpc::XmlRpcValue::TypeString) {
+          problems->push_back(key + ": not a string (" + spec.allowedText() + ")");
+        } else {
+          spec.setString(&config, static_cast<std::string>(value));
+        }
+        break;
+      case Type::kBool:
+        if (value.getType() != XmlRpc::XmlRpcValue::TypeBoolean) {
+          problems->push_back(key + ": not a boolean (true or false)");
+        } else {
+          spec.setBool(&config, static_cast<bool>(value));
+        }
+        break;
+      case Type::kInteger:
+        if (value.getType() != XmlRpc::XmlRpcValue::TypeInt) {
+          problems->push_back(key + ": not an integer (" + spec.doc + ")");
+        } else {
+          spec.setNumber(&config, static_cast<int>(value));
+        }
+        break;
+      case Type::kReal: {
+        double number = 0.0;
+        if (!toNumber(value, &number)) {
+          problems->push_back(key + ": not a number (" + spec.doc + ")");
+        } else {
+          spec.setNumber(&config, number);
+        }
+        break;
+      }
+    }
+  }
+  // A misspelt key would otherwise be ignored silently.
+  XmlRpc::XmlRpcValue section;
+  if (nh.getParam("front_end", section) && section.getType() == XmlRpc::XmlRpcValue::TypeStruct) {
+    for (const auto& entry : section) {
+      bool known = false;
+      for (const osc::FrontEndParameterSpec& spec : osc::frontEndParameterTable()) {
+        known |= spec.name == entry.first;
+      }
+      if (!known) problems->push_back("front_end/" + entry.first + ": unknown parameter");
+    }
+  }
   for (const std::string& problem : config.validate()) problems->push_back("front_end/" + problem);
   return config;
 }

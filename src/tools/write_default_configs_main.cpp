@@ -1,5 +1,7 @@
-// Writes config/default.yaml and config/paper.yaml from the code's defaults, so the files
-// and the code cannot disagree (test_filter_config_yaml checks that they are up to date).
+// Writes config/default.yaml and config/paper.yaml from the code's defaults (the filter's
+// keys from filterParameterTable(), the front end's `front_end:` section from
+// frontEndParameterTable()), so the files and the code cannot disagree
+// (test_filter_config_yaml checks that they are up to date).
 //   write_default_configs CONFIG_DIR
 #include <fstream>
 #include <iostream>
@@ -7,7 +9,7 @@
 #include <vector>
 
 #include "online_stereo_calibration/tools/command_line.h"
-#include "online_stereo_calibration/tools/filter_config_yaml.h"
+#include "online_stereo_calibration/tools/estimator_config_yaml.h"
 
 int main(int argc, char** argv) {
   std::vector<std::string> directories;
@@ -20,13 +22,15 @@ int main(int argc, char** argv) {
       [&] {
         if (!cli.parse(argc, argv)) return 0;
         const std::string dir = directories.front();
-        std::ofstream(dir + "/default.yaml") << osc::formatFilterConfigYaml(
-            osc::FilterConfig(),
+        osc::EstimatorConfig paper;
+        paper.filter = osc::paperFilterConfig();
+        std::ofstream(dir + "/default.yaml") << osc::formatEstimatorConfigYaml(
+            osc::EstimatorConfig(),
             "online_stereo_calibration: shipped defaults (docs/RESULTS.md "
             "has the figures behind every value that differs from "
             "paper.yaml)");
-        std::ofstream(dir + "/paper.yaml") << osc::formatFilterConfigYaml(
-            osc::paperFilterConfig(),
+        std::ofstream(dir + "/paper.yaml") << osc::formatEstimatorConfigYaml(
+            paper,
             "online_stereo_calibration: the seed paper's values (Mueller "
             "& Wuensche 2016, eq. 10-15); values the paper does not give "
             "are our defaults");

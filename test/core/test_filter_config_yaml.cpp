@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "online_stereo_calibration/tools/estimator_config_yaml.h"
 #include "online_stereo_calibration/tools/filter_config_yaml.h"
 
 namespace osc {
@@ -28,17 +29,23 @@ TEST(FilterConfigYaml, ShippedFilesAreUpToDateWithTheCode) {
   // Regenerate with: write_default_configs config
   const std::string file = readText(std::string(OSC_SOURCE_DIR) + "/config/default.yaml");
   const std::string title = file.substr(2, file.find('\n') - 2);
-  EXPECT_EQ(file, formatFilterConfigYaml(FilterConfig(), title));
-  expectSameConfig(readFilterConfigFile(std::string(OSC_SOURCE_DIR) + "/config/default.yaml"), FilterConfig());
-  expectSameConfig(readFilterConfigFile(std::string(OSC_SOURCE_DIR) + "/config/paper.yaml"), paperFilterConfig());
+  EXPECT_EQ(file, formatEstimatorConfigYaml(EstimatorConfig(), title));
+  const std::string paper = readText(std::string(OSC_SOURCE_DIR) + "/config/paper.yaml");
+  EstimatorConfig paper_config;
+  paper_config.filter = paperFilterConfig();
+  EXPECT_EQ(paper, formatEstimatorConfigYaml(paper_config, paper.substr(2, paper.find('\n') - 2)));
+  expectSameConfig(readFilterConfigFile(std::string(OSC_SOURCE_DIR) + "/config/default.yaml"),
+                   FilterConfig());
+  expectSameConfig(readFilterConfigFile(std::string(OSC_SOURCE_DIR) + "/config/paper.yaml"),
+                   paperFilterConfig());
 }
 
 TEST(FilterConfigYaml, PaperFileHoldsThePapersNumbers) {
   const std::string text = readText(std::string(OSC_SOURCE_DIR) + "/config/paper.yaml");
-  EXPECT_NE(text.find("point_position_noise_m: 0.2\n"), std::string::npos);          // eq. 14
-  EXPECT_NE(text.find("motion_rotation_noise_deg: 0.02\n"), std::string::npos);      // eq. 15
-  EXPECT_NE(text.find("caml_rotation_drift_deg: 0.005\n"), std::string::npos);       // eq. 11
-  EXPECT_NE(text.find("camr_translation_drift_m: 1e-05\n"), std::string::npos);      // eq. 12
+  EXPECT_NE(text.find("point_position_noise_m: 0.2\n"), std::string::npos);      // eq. 14
+  EXPECT_NE(text.find("motion_rotation_noise_deg: 0.02\n"), std::string::npos);  // eq. 15
+  EXPECT_NE(text.find("caml_rotation_drift_deg: 0.005\n"), std::string::npos);   // eq. 11
+  EXPECT_NE(text.find("camr_translation_drift_m: 1e-05\n"), std::string::npos);  // eq. 12
   EXPECT_NE(text.find("motion_noise_model: per_point\n"), std::string::npos);
 }
 
@@ -58,8 +65,9 @@ TEST(FilterConfigYaml, PartialFileKeepsOtherDefaults) {
 
 TEST(FilterConfigYaml, BadFilesNameEveryProblem) {
   try {
-    parseFilterConfigYaml("pixel_noise_px: -1\nmax_points: many\nsigma_typo_m: 3\nmotion_noise_model: wild\n",
-                          "bad.yaml");
+    parseFilterConfigYaml(
+        "pixel_noise_px: -1\nmax_points: many\nsigma_typo_m: 3\nmotion_noise_model: wild\n",
+        "bad.yaml");
     FAIL() << "a bad file must be refused";
   } catch (const std::runtime_error& e) {
     const std::string m = e.what();

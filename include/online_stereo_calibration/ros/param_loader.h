@@ -1,6 +1,7 @@
 /// @file param_loader.h
 /// @brief Reads FilterConfig (through filterParameterTable(), one place for names),
-/// FrontEndConfig and RosConfig from the parameter server, collecting every problem.
+/// FrontEndConfig (through frontEndParameterTable()) and RosConfig from the parameter server,
+/// collecting every problem.
 #pragma once
 
 #include <string>
@@ -29,7 +30,8 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh, std::vector<std::string>* p
 /// Reads the filter keys of filterParameterTable() (and motion_noise_model) only.
 osc::FilterConfig loadFilterConfig(const ros::NodeHandle& nh, std::vector<std::string>* problems);
 
-/// Reads the front end's keys (under `front_end/`, named as the FrontEndConfig fields).
+/// Reads the front end's keys: every row of frontEndParameterTable() as `front_end/<name>`
+/// (the FrontEndConfig field names).
 osc::FrontEndConfig loadFrontEndConfig(const ros::NodeHandle& nh,
                                        std::vector<std::string>* problems);
 

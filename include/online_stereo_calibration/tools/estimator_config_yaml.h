@@ -5,9 +5,10 @@
 /// nodelet reads from its private namespace (`~front_end/...`, config/ros.yaml):
 ///
 ///   pixel_noise_px: 0.5        # FilterConfig (filterParameterTable names)
-///   front_end:                 # FrontEndConfig field names
+///   front_end:                 # FrontEndConfig field names (frontEndParameterTable)
 ///     detector: FAST_ORB
 ///     max_features: 1500
+///     search_lost_tracks: true
 #pragma once
 
 #include <string>
@@ -24,19 +25,6 @@ struct EstimatorConfig {
   FrontEndConfig front_end;
 };
 
-/// One key of FrontEndConfig (for reading, writing and the docs).
-struct FrontEndKey {
-  enum class Type { kInteger, kReal, kString };
-  std::string name;  ///< field name = YAML key under front_end:
-  Type type = Type::kReal;
-  int FrontEndConfig::*integer_field = nullptr;
-  double FrontEndConfig::*real_field = nullptr;
-  std::string FrontEndConfig::*string_field = nullptr;
-};
-
-/// Every field of FrontEndConfig, in declaration order.
-const std::vector<FrontEndKey>& frontEndKeyTable();
-
 /// Reads the filter keys (top level) and the front-end keys (under `front_end:`); keys not
 /// given keep the value of @p base. Unknown keys (at either level), values of the wrong type
 /// and values out of range (FilterConfig::validate, FrontEndConfig::validate) are errors:
@@ -49,7 +37,12 @@ EstimatorConfig parseEstimatorConfigYaml(const std::string& text, const std::str
 EstimatorConfig readEstimatorConfigFile(const std::string& path,
                                         const EstimatorConfig& base = EstimatorConfig());
 
-/// The `front_end:` section of a loadable file: every key with its value.
+/// The `front_end:` section of a loadable file: every key of frontEndParameterTable() with
+/// its value, each after a comment with its meaning and allowed range.
 std::string formatFrontEndConfigYaml(const FrontEndConfig& config);
+
+/// A whole loadable file: formatFilterConfigYaml(config.filter, title) followed by the
+/// `front_end:` section (what write_default_configs writes to config/default.yaml).
+std::string formatEstimatorConfigYaml(const EstimatorConfig& config, const std::string& title);
 
 }  // namespace osc

@@ -2,64 +2,280 @@
 
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 namespace osc {
 namespace {
 
-void checkRange(std::vector<std::string>* problems, const char* name, double value, double low,
-                double high, bool low_open = false) {
-  const bool ok = std::isfinite(value) && (low_open ? value > low : value >= low) && value <= high;
-  if (!ok) {
-    std::ostringstream s;
-    s << name << " = " << value << " is outside " << (low_open ? "(" : "[") << low << ", " << high
-      << "]";
-    problems->push_back(s.str());
-  }
+using Type = FrontEndParameterSpec::Type;
+
+FrontEndParameterSpec text(const char* name, std::string FrontEndConfig::*field,
+                           std::vector<std::string> allowed, const char* doc) {
+  FrontEndParameterSpec s;
+  s.name = name;
+  s.doc = doc;
+  s.type = Type::kString;
+  s.allowed_values = std::move(allowed);
+  s.string_field = field;
+  return s;
 }
+
+FrontEndParameterSpec integer(const char* name, int FrontEndConfig::*field, int lo, int hi,
+                              const char* doc) {
+  FrontEndParameterSpec s;
+  s.name = name;
+  s.doc = doc;
+  s.type = Type::kInteger;
+  s.min_value = lo;
+  s.max_value = hi;
+  s.integer_field = field;
+  return s;
+}
+
+/// A real in [lo, hi], or (lo, hi] if @p lo_open.
+FrontEndParameterSpec real(const char* name, double FrontEndConfig::*field, double lo, double hi,
+                           bool lo_open, const char* doc) {
+  FrontEndParameterSpec s;
+  s.name = name;
+  s.doc = doc;
+  s.type = Type::kReal;
+  s.min_value = lo;
+  s.max_value = hi;
+  s.min_open = lo_open;
+  s.real_field = field;
+  return s;
+}
+
+/// A real in [config.*lo_field, hi].
+FrontEndParameterSpec realAbove(const char* name, double FrontEndConfig::*field,
+                                double FrontEndConfig::*lo_field, double hi, const char* doc) {
+  FrontEndParameterSpec s = real(name, field, 0.0, hi, false, doc);
+  s.min_from_field = lo_field;
+  return s;
+}
+
+FrontEndParameterSpec boolean(const char* name, bool FrontEndConfig::*field, const char* doc) {
+  FrontEndParameterSpec s;
+  s.name = name;
+  s.doc = doc;
+  s.type = Type::kBool;
+  s.bool_field = field;
+  return s;
+}
+
+constexpr bool kOpen = true;
+constexpr bool kClosed = false;
 
 }  // namespace
 
-std::vector<std::string> FrontEndConfig::validate() const {
-  std::vector<std::string> p;
-  if (detector != "ORB" && detector != "FAST_ORB" && detector != "AKAZE" && detector != "SIFT") {
-    p.push_back("detector = '" + detector + "' is not one of ORB, FAST_ORB, AKAZE, SIFT");
+double FrontEndParameterSpec::getNumber(const FrontEndConfig& config) const {
+  switch (type) {
+    case Type::kInteger:
+      return static_cast<double>(config.*integer_field);
+    case Type::kReal:
+      return config.*real_field;
+    case Type::kBool:
+      return config.*bool_field ? 1.0 : 0.0;
+    case Type::kString:
+      break;
   }
-  checkRange(&p, "max_features", max_features, 50, 50000);
-  checkRange(&p, "fast_threshold", fast_threshold, 1, 255);
-  checkRange(&p, "orb_levels", orb_levels, 1, 16);
-  checkRange(&p, "orb_scale_factor", orb_scale_factor, 1.0, 2.0, true);
-  checkRange(&p, "detection_grid", detection_grid, 1, 64);
-  checkRange(&p, "border", border, 0.0, 100.0);
-  checkRange(&p, "band_sigmas", band_sigmas, 0.0, 10.0, true);
-  checkRange(&p, "min_band", min_band, 0.1, 50.0);
-  checkRange(&p, "max_band", max_band, min_band, 500.0);
-  checkRange(&p, "pixel_sigma", pixel_sigma, 0.0, 10.0);
-  checkRange(&p, "max_descriptor_distance", max_descriptor_distance, 0.0, 1.0, true);
-  checkRange(&p, "ratio", ratio, 0.0, 1.0, true);
-  checkRange(&p, "patch_half_size", patch_half_size, 1, 15);
-  checkRange(&p, "max_refinement_shift", max_refinement_shift, 0.0, 20.0, true);
-  checkRange(&p, "max_temporal_shift", max_temporal_shift, 0.0, 20.0, true);
-  checkRange(&p, "min_search_ncc", min_search_ncc, -1.0, 1.0);
-  checkRange(&p, "max_forward_backward", max_forward_backward, 0.0, 10.0, true);
-  checkRange(&p, "discontinuity_search", discontinuity_search, 0, 20);
-  checkRange(&p, "min_patch_ncc", min_patch_ncc, -1.0, 1.0);
-  checkRange(&p, "min_patch_eigen_ratio", min_patch_eigen_ratio, 0.0, 1.0);
-  checkRange(&p, "refined_pixel_sigma", refined_pixel_sigma, 0.0, 10.0, true);
-  checkRange(&p, "bucket_cols", bucket_cols, 1, 64);
-  checkRange(&p, "bucket_rows", bucket_rows, 1, 64);
-  checkRange(&p, "max_new_points_per_frame", max_new_points_per_frame, 0, 10000);
-  checkRange(&p, "min_distance_to_track", min_distance_to_track, 0.0, 200.0);
-  checkRange(&p, "min_parallax_deg", min_parallax_deg, 0.0, 30.0);
-  checkRange(&p, "track_window_sigmas", track_window_sigmas, 0.0, 10.0, true);
-  checkRange(&p, "min_track_window", min_track_window, 0.5, 100.0);
-  checkRange(&p, "max_track_window", max_track_window, min_track_window, 500.0);
-  checkRange(&p, "max_track_descriptor_distance", max_track_descriptor_distance, 0.0, 1.0, true);
-  checkRange(&p, "track_ratio", track_ratio, 0.0, 1.0, true);
-  checkRange(&p, "reacquire_below_fraction", reacquire_below_fraction, 0.0, 1.0, false);
-  checkRange(&p, "track_gate_chi2_2dof", track_gate_chi2_2dof, 0.0, 1000.0, true);
-  checkRange(&p, "min_image_size", min_image_size, 8, 10000);
-  checkRange(&p, "min_contrast", min_contrast, 0.0, 100.0);
-  return p;
+  return 0.0;
+}
+
+void FrontEndParameterSpec::setNumber(FrontEndConfig* config, double value) const {
+  switch (type) {
+    case Type::kInteger:
+      config->*integer_field = static_cast<int>(std::lround(value));
+      break;
+    case Type::kReal:
+      config->*real_field = value;
+      break;
+    case Type::kBool:
+      config->*bool_field = value != 0.0;
+      break;
+    case Type::kString:
+      break;
+  }
+}
+
+const std::string& FrontEndParameterSpec::getString(const FrontEndConfig& config) const {
+  return config.*string_field;
+}
+
+void FrontEndParameterSpec::setString(FrontEndConfig* config, const std::string& value) const {
+  config->*string_field = value;
+}
+
+bool FrontEndParameterSpec::getBool(const FrontEndConfig& config) const {
+  return config.*bool_field;
+}
+
+void FrontEndParameterSpec::setBool(FrontEndConfig* config, bool value) const {
+  config->*bool_field = value;
+}
+
+std::string FrontEndParameterSpec::format(const FrontEndConfig& config) const {
+  std::ostringstream out;
+  out.precision(12);
+  switch (type) {
+    case Type::kString:
+      out << config.*string_field;
+      break;
+    case Type::kInteger:
+      out << config.*integer_field;
+      break;
+    case Type::kReal:
+      out << config.*real_field;
+      break;
+    case Type::kBool:
+      out << (config.*bool_field ? "true" : "false");
+      break;
+  }
+  return out.str();
+}
+
+std::string FrontEndParameterSpec::allowedText() const {
+  std::ostringstream out;
+  switch (type) {
+    case Type::kString:
+      out << "{";
+      for (size_t i = 0; i < allowed_values.size(); ++i) {
+        out << (i ? ", " : "") << allowed_values[i];
+      }
+      out << "}";
+      break;
+    case Type::kBool:
+      out << "{true, false}";
+      break;
+    case Type::kInteger:
+    case Type::kReal: {
+      out << (min_open ? "(" : "[");
+      if (min_from_field != nullptr) {
+        for (const FrontEndParameterSpec& other : frontEndParameterTable()) {
+          if (other.real_field == min_from_field) out << other.name;
+        }
+      } else {
+        out << min_value;
+      }
+      out << ", " << max_value << "]";
+      break;
+    }
+  }
+  return out.str();
+}
+
+std::string FrontEndParameterSpec::check(const FrontEndConfig& config) const {
+  std::ostringstream s;
+  if (type == Type::kString) {
+    if (allowed_values.empty()) return "";
+    for (const std::string& v : allowed_values) {
+      if (config.*string_field == v) return "";
+    }
+    s << name << " = '" << config.*string_field << "' is not one of ";
+    for (size_t i = 0; i < allowed_values.size(); ++i) s << (i ? ", " : "") << allowed_values[i];
+    return s.str();
+  }
+  if (type == Type::kBool) return "";
+  const double value = getNumber(config);
+  const double low = min_from_field != nullptr ? config.*min_from_field : min_value;
+  const bool ok =
+      std::isfinite(value) && (min_open ? value > low : value >= low) && value <= max_value;
+  if (ok) return "";
+  s << name << " = " << value << " is outside " << (min_open ? "(" : "[") << low << ", "
+    << max_value << "]";
+  return s.str();
+}
+
+const std::vector<FrontEndParameterSpec>& frontEndParameterTable() {
+  using C = FrontEndConfig;
+  static const std::vector<FrontEndParameterSpec> table = {
+      // --- detection and description ---
+      text("detector", &C::detector, {"ORB", "FAST_ORB", "AKAZE", "SIFT"},
+           "feature detector/descriptor; FAST_ORB (one level, full image) is the fastest"),
+      integer("max_features", &C::max_features, 50, 50000, "most keypoints kept per image"),
+      integer("fast_threshold", &C::fast_threshold, 1, 255,
+              "FAST threshold (grey levels) of ORB / FAST_ORB"),
+      integer("orb_levels", &C::orb_levels, 1, 16, "pyramid levels of ORB"),
+      real("orb_scale_factor", &C::orb_scale_factor, 1.0, 2.0, kOpen,
+           "scale factor between ORB pyramid levels"),
+      integer("detection_grid", &C::detection_grid, 1, 64,
+              "keypoints spread over this many grid cells per axis (1 = no spreading)"),
+      real("border", &C::border, 0.0, 100.0, kClosed,
+           "keypoints closer than this to the image border are ignored (px)"),
+      // --- epipolar-guided stereo matching (eq. 5-6) ---
+      real("band_sigmas", &C::band_sigmas, 0.0, 10.0, kOpen,
+           "half-width of the epipolar band in sigmas of the line distance"),
+      real("min_band", &C::min_band, 0.1, 50.0, kClosed, "least half-width of the band (px)"),
+      realAbove("max_band", &C::max_band, &C::min_band, 500.0,
+                "largest half-width of the band (px); bounds the search when very uncertain"),
+      real("pixel_sigma", &C::pixel_sigma, 0.0, 10.0, kClosed,
+           "pixel noise (px) per image added to the band"),
+      real("max_descriptor_distance", &C::max_descriptor_distance, 0.0, 1.0, kOpen,
+           "largest normalised descriptor distance of a stereo match"),
+      real("ratio", &C::ratio, 0.0, 1.0, kOpen,
+           "Lowe's ratio: best distance < ratio * second best among the candidates"),
+      // --- sub-pixel refinement and verification ---
+      integer("patch_half_size", &C::patch_half_size, 1, 15,
+              "half-size (px) of the patch aligned into the other image (sub-pixel refinement)"),
+      real("max_refinement_shift", &C::max_refinement_shift, 0.0, 20.0, kOpen,
+           "largest move (px) of the stereo alignment from the matched right keypoint"),
+      real("max_temporal_shift", &C::max_temporal_shift, 0.0, 20.0, kOpen,
+           "largest move (px) of a track's alignment from the keypoint found"),
+      real("min_patch_ncc", &C::min_patch_ncc, -1.0, 1.0, kClosed,
+           "least normalised cross-correlation of the aligned patches"),
+      boolean("search_lost_tracks", &C::search_lost_tracks,
+              "search tracks whose keypoint was not re-detected by aligning their patch"),
+      real("min_search_ncc", &C::min_search_ncc, -1.0, 1.0, kClosed,
+           "search_lost_tracks: least NCC of the aligned patch"),
+      real("max_forward_backward", &C::max_forward_backward, 0.0, 10.0, kOpen,
+           "search_lost_tracks: largest forward-backward alignment error (px)"),
+      integer("discontinuity_search", &C::discontinuity_search, 0, 20,
+              "depth-discontinuity check: half-patch shifts searched (px, 0 = off)"),
+      real("min_patch_eigen_ratio", &C::min_patch_eigen_ratio, 0.0, 1.0, kClosed,
+           "least small/large eigenvalue ratio of the patch's structure tensor (edges fail)"),
+      real("refined_pixel_sigma", &C::refined_pixel_sigma, 0.0, 10.0, kOpen,
+           "pixel noise (px) per image of the epipolar band check of a refined pair"),
+      // --- spatial sampling ---
+      integer("bucket_cols", &C::bucket_cols, 1, 64, "bucketing grid columns for new points"),
+      integer("bucket_rows", &C::bucket_rows, 1, 64, "bucketing grid rows for new points"),
+      integer("max_new_points_per_frame", &C::max_new_points_per_frame, 0, 10000,
+              "most new points offered per frame"),
+      real("min_distance_to_track", &C::min_distance_to_track, 0.0, 200.0, kClosed,
+           "no new point within this distance (px, left image) of a tracked one"),
+      real("min_parallax_deg", &C::min_parallax_deg, 0.0, 30.0, kClosed,
+           "least angle between the two rays of a new point (deg)"),
+      // --- tracking (Sec. II-C) ---
+      real("track_window_sigmas", &C::track_window_sigmas, 0.0, 10.0, kOpen,
+           "track search window half-size in sigmas of the predicted pixel"),
+      real("min_track_window", &C::min_track_window, 0.5, 100.0, kClosed,
+           "least half-size of the track search window (px)"),
+      realAbove("max_track_window", &C::max_track_window, &C::min_track_window, 500.0,
+                "largest half-size of the track search window (px)"),
+      real("max_track_descriptor_distance", &C::max_track_descriptor_distance, 0.0, 1.0, kOpen,
+           "largest normalised descriptor distance of a track to its stored descriptor"),
+      real("track_ratio", &C::track_ratio, 0.0, 1.0, kOpen,
+           "ratio test of a track within its window (1 = off)"),
+      real("track_gate_chi2_2dof", &C::track_gate_chi2_2dof, 0.0, 1000.0, kOpen,
+           "gate on a track's squared Mahalanobis distance from its prediction (13.8 = 99.9 %)"),
+      real("reacquire_below_fraction", &C::reacquire_below_fraction, 0.0, 1.0, kClosed,
+           "below this fraction of tracks found, the lost ones are searched over the whole "
+           "image (a sudden calibration change; 0 = off)"),
+      // --- input checks ---
+      integer("min_image_size", &C::min_image_size, 8, 10000,
+              "least image size accepted (px, each axis)"),
+      real("min_contrast", &C::min_contrast, 0.0, 100.0, kClosed,
+           "least grey-level standard deviation; below, the image is rejected as uniform"),
+  };
+  return table;
+}
+
+std::vector<std::string> FrontEndConfig::validate() const {
+  std::vector<std::string> problems;
+  for (const FrontEndParameterSpec& spec : frontEndParameterTable()) {
+    std::string problem = spec.check(*this);
+    if (!problem.empty()) problems.push_back(std::move(problem));
+  }
+  return problems;
 }
 
 }  // namespace osc

@@ -1,6 +1,9 @@
 /// @file front_end_config.h
 /// @brief Every tunable of the image front end (seed Sec. II-A, II-C): detection, the
-/// epipolar-guided stereo matching (eq. 5-6), bucketing, new-point checks and tracking.
+/// epipolar-guided stereo matching (eq. 5-6), bucketing, new-point checks and tracking, and
+/// frontEndParameterTable(), the one list of its keys (name, type, range, meaning) that
+/// validate(), the YAML loader (`front_end:`), the ROS loader (`~front_end/`) and
+/// write_default_configs read.
 #pragma once
 
 #include <string>
@@ -116,8 +119,53 @@ struct FrontEndConfig {
   /// as all black, saturated or uniform. [0, 100].
   double min_contrast = 2.0;
 
-  /// Every problem found, each naming the field, its value and the allowed range.
+  /// Every problem found, each naming the field, its value and the allowed range
+  /// (checks every row of frontEndParameterTable()).
   std::vector<std::string> validate() const;
 };
+
+/// One row of the front end's parameter table: one FrontEndConfig field.
+struct FrontEndParameterSpec {
+  enum class Type { kString, kInteger, kReal, kBool };
+  std::string name;  ///< field name = key under `front_end:` (YAML) / `~front_end/` (ROS)
+  std::string doc;   ///< one line for humans
+  Type type = Type::kReal;
+  /// Numbers: allowed range [min_value, max_value]; (min_value, ...] if min_open.
+  double min_value = 0.0;
+  double max_value = 0.0;
+  bool min_open = false;
+  /// Numbers: if set, the lower bound is this field's value instead of min_value (e.g.
+  /// max_band >= min_band).
+  double FrontEndConfig::*min_from_field = nullptr;
+  /// Strings: the allowed values (empty = any).
+  std::vector<std::string> allowed_values;
+  std::string FrontEndConfig::*string_field = nullptr;
+  int FrontEndConfig::*integer_field = nullptr;
+  double FrontEndConfig::*real_field = nullptr;
+  bool FrontEndConfig::*bool_field = nullptr;
+
+  bool isNumber() const { return type == Type::kInteger || type == Type::kReal; }
+  /// Integer and real fields: the value (bool: 0 / 1).
+  double getNumber(const FrontEndConfig& config) const;
+  /// Integer and real fields (integers rounded), bool (non-zero = true). No range check.
+  void setNumber(FrontEndConfig* config, double value) const;
+  /// String fields.
+  const std::string& getString(const FrontEndConfig& config) const;
+  void setString(FrontEndConfig* config, const std::string& value) const;
+  /// Bool fields.
+  bool getBool(const FrontEndConfig& config) const;
+  void setBool(FrontEndConfig* config, bool value) const;
+  /// The value as written in a YAML file: 12, 0.35, true, ORB.
+  std::string format(const FrontEndConfig& config) const;
+  /// The allowed range or values for the docs: "[1, 15]", "(0, 1]", "[min_band, 500]",
+  /// "{ORB, FAST_ORB, AKAZE, SIFT}", "{true, false}".
+  std::string allowedText() const;
+  /// The problem with this field's value in @p config, "" if none; names the key:
+  /// "ratio = 3 is outside (0, 1]".
+  std::string check(const FrontEndConfig& config) const;
+};
+
+/// Every field of FrontEndConfig, in declaration order.
+const std::vector<FrontEndParameterSpec>& frontEndParameterTable();
 
 }  // namespace osc
