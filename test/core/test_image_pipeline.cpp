@@ -59,5 +59,42 @@ TEST(ImagePipeline, ConvergesOnAShortRenderedDrive) {
   EXPECT_GE(tracks_correct, 0.93 * tracks);
 }
 
+// A knocked camera at image level: the 10 deg yaw step of x_caml moves every point ~90 px
+// from its prediction, far outside the track windows. The lost tracks are searched over the
+// whole image (reacquire_below_fraction), reach the filter as outliers, and it detects the
+// change at the step frame and pulls yaw_l back.
+TEST(ImagePipeline, DetectsAndFollowsASuddenYawStepOfTheCamera) {
+  MeasurementScenario scenario = paperOffroadScenario();
+  scenario.frames = 130;
+  scenario.step_frame = 100;
+  // A camera calibrated before (no start error, small start sigmas): the step meets a
+  // converged filter, as at frame 774 of the paper's drive, without 774 frames to render.
+  scenario.initial_error.setZero();
+  FilterConfig calibrated;
+  calibrated.initial_caml_translation_sigma = 0.02;
+  calibrated.initial_caml_rotation_sigma = 0.2 * kDeg;
+  const std::vector<ImageFrameResult> results =
+      runImageScenario(scenario, calibrated, FrontEndConfig(), ImageScenarioOptions(),
+                       [&](const ImageFrameResult&, const CalibrationPipeline&) {});
+  ASSERT_EQ(results.size(), 130u);
+  int jumps = 0, first_jump = -1;
+  for (const ImageFrameResult& r : results) {
+    if (!r.filter.jump_detected) continue;
+    if (first_jump < 0) first_jump = r.filter.frame;
+    ++jumps;
+  }
+  EXPECT_EQ(first_jump, 100);
+  EXPECT_EQ(jumps, 1);
+  const ImageFrameResult& last = results.back();
+  const double yaw_error =
+      std::remainder(last.filter.parameters(5) - last.filter.truth(5), 2 * M_PI);
+  std::printf("  jump at frame %d; yaw_l error at frame %d: %.3f deg\n", first_jump,
+              last.filter.frame, yaw_error / kDeg);
+  // Back from 10 deg to the pre-step level (the image-level x_caml bias of ~0.6 deg, see
+  // docs/RESULTS.md; NOT YET the 0.3 deg).
+  EXPECT_LT(std::abs(yaw_error), 1.0 * kDeg);
+  EXPECT_GE(last.filter.tracked_points, 30);
+}
+
 }  // namespace
 }  // namespace osc
