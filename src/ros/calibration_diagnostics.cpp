@@ -62,6 +62,7 @@ void CalibrationDiagnostics::tickOdom() {
   odom_frequency_.tick();
   std::lock_guard<std::mutex> lock(mutex_);
   ++inputs_.odom;
+  last_odom_wall_ = ros::WallTime::now();
 }
 
 void CalibrationDiagnostics::tickInput(bool left, bool camera_info) {
@@ -144,7 +145,11 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
     level = std::max<unsigned char>(level, DiagnosticStatus::WARN);
     reasons.push_back("images and camera_info do not pair (stamps differ?)");
   }
-  if (pairs > 0 && odom == 0 && config_.motion_source == MotionSourceType::kOdom) {
+  // Pairs arrive but the latest odometry is over a second old (or there never was any).
+  constexpr double kOdomSilence = 1.0;  // s, wall clock
+  const bool odom_silent =
+      last_odom_wall_.isZero() || (ros::WallTime::now() - last_odom_wall_).toSec() > kOdomSilence;
+  if (pairs > 0 && odom_silent && config_.motion_source == MotionSourceType::kOdom) {
     level = DiagnosticStatus::ERROR;
     reasons.push_back("no odometry (image pairs arrive)");
   }

@@ -71,6 +71,9 @@ class CalibrationDiagnostics {
   std::string last_problem_;
   InputCounts inputs_;
   InputCounts inputs_at_last_report_;
+  /// Wall time of the latest motion sample (zero: none yet): "no odometry" is judged by how
+  /// long ago it was, not by whole report periods without one (reports are not punctual).
+  ros::WallTime last_odom_wall_;
   std::string initial_guess_;
   bool have_estimate_ = false;
   osc::CalibrationEstimate estimate_;
