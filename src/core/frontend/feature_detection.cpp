@@ -6,6 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include <opencv2/core/version.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -159,9 +160,15 @@ FeatureDetector::FeatureDetector(const FrontEndConfig& config) : config_(config)
     detector_ = akaze;
     describer_ = akaze;
   } else if (config.detector == "SIFT") {
+#if CV_VERSION_MAJOR > 4 || (CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 4)
     auto sift = cv::SIFT::create(candidates);
     detector_ = sift;
     describer_ = sift;
+#else  // Ubuntu 20.04 ships OpenCV 4.2, where SIFT lives in the contrib module xfeatures2d.
+    throw std::invalid_argument(
+        "FrontEndConfig.detector: SIFT needs OpenCV >= 4.4 (this build has " CV_VERSION
+        "); use ORB, FAST_ORB or AKAZE");
+#endif
   } else {
     throw std::invalid_argument("FrontEndConfig.detector: unknown detector '" + config.detector +
                                 "' (ORB, FAST_ORB, AKAZE, SIFT)");
