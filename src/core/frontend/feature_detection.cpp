@@ -220,6 +220,15 @@ FeatureSet FeatureDetector::detect(const cv::Mat& mono, const CameraModel& camer
 
   FeatureSet set;
   cv::Mat descriptors;
+  // A keypoint the lens model has no ray for (beyond the fold of a strong distortion
+  // polynomial, camera_model.h) cannot be measured: dropped before it is described.
+  Eigen::Vector2d unused;
+  selected.erase(std::remove_if(selected.begin(), selected.end(),
+                                [&](const cv::KeyPoint& k) {
+                                  return !camera.undistortPixel(Eigen::Vector2d(k.pt.x, k.pt.y),
+                                                                &unused);
+                                }),
+                 selected.end());
   if (!selected.empty()) describer_->compute(mono, selected, descriptors);
   set.descriptors = descriptors;
   set.binary = descriptors.empty() || descriptors.depth() == CV_8U;
