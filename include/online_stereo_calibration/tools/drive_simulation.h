@@ -50,9 +50,13 @@ class DriveSimulator {
   SimulatedImagePair renderFrame(int frame) const;
 
   /// Noisy odometry T_odom_veh at odom_rate_hz (ROS stamps) from frame 0's stamp to one odom
-  /// period past the last frame: the true pose times a body-frame random-walk error whose
-  /// increments have the scenario's motion_rotation_noise / motion_translation_noise per
-  /// 0.1 s (scaled by sqrt(dt / 0.1)), like an INS.
+  /// period past the last frame, dead-reckoned: each true increment between two samples gets
+  /// an independent error of the scenario's motion_rotation_noise / motion_translation_noise
+  /// per 0.1 s (scaled by sqrt(dt / 0.1)) and the noisy increments are chained. So the motion
+  /// between two image pairs has independent noise, as the filter's model (eq. 15) and the
+  /// measurement-level simulator assume, while the absolute pose drifts. (Multiplying the true
+  /// pose by an accumulated body-frame error instead would rotate every later increment by
+  /// that error, ~0.7 deg after 1000 frames: a systematic error that biased x_caml.)
   std::vector<StampedPose> odometry() const;
 
   const SimulationScenario& scenario() const { return scenario_; }

@@ -103,9 +103,9 @@ std::vector<StampedPose> DriveSimulator::odometry() const {
   const double scale = std::sqrt(period / kNoiseReferenceStep);
   std::mt19937_64 engine(0x5eedULL * (scenario_.measurement.seed + 1ULL) + 17ULL);
   std::normal_distribution<double> normal(0.0, 1.0);
-  Eigen::Isometry3d error = Eigen::Isometry3d::Identity();
   std::vector<StampedPose> out;
   out.reserve(samples);
+  Eigen::Isometry3d pose = truePose(0.0);
   for (int k = 0; k < samples; ++k) {
     const double t = k * period;
     if (k > 0) {
@@ -116,9 +116,10 @@ std::vector<StampedPose> DriveSimulator::odometry() const {
       for (int i = 3; i < 6; ++i) {
         delta(i) = scale * scenario_.measurement.motion_rotation_noise * normal(engine);
       }
-      error = boxPlus(error, delta);
+      const Eigen::Isometry3d true_step = truePose(t - period).inverse() * truePose(t);
+      pose = pose * boxPlus(true_step, delta);
     }
-    out.push_back({scenario_.rendering.start_stamp + t, truePose(t) * error});
+    out.push_back({scenario_.rendering.start_stamp + t, pose});
   }
   return out;
 }

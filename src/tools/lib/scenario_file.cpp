@@ -16,7 +16,8 @@ namespace osc {
 namespace {
 
 /// Version of the simulator's output; part of the cache fingerprint.
-constexpr const char* kSimulatorVersion = "simulate-2";  // 2: scene along the whole drive
+constexpr const char* kSimulatorVersion =
+    "simulate-3";  // 2: scene along the whole drive, 3: dead-reckoned odometry
 
 /// Collects problems instead of stopping at the first.
 struct Problems {
