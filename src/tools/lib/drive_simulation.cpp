@@ -105,7 +105,7 @@ std::vector<StampedPose> DriveSimulator::odometry() const {
   std::normal_distribution<double> normal(0.0, 1.0);
   std::vector<StampedPose> out;
   out.reserve(samples);
-  Eigen::Isometry3d pose = truePose(0.0);
+  Eigen::Isometry3d pose = truePose(0.0), previous_true = pose;
   for (int k = 0; k < samples; ++k) {
     const double t = k * period;
     if (k > 0) {
@@ -116,8 +116,9 @@ std::vector<StampedPose> DriveSimulator::odometry() const {
       for (int i = 3; i < 6; ++i) {
         delta(i) = scale * scenario_.measurement.motion_rotation_noise * normal(engine);
       }
-      const Eigen::Isometry3d true_step = truePose(t - period).inverse() * truePose(t);
-      pose = pose * boxPlus(true_step, delta);
+      const Eigen::Isometry3d current_true = truePose(t);
+      pose = pose * boxPlus(previous_true.inverse() * current_true, delta);
+      previous_true = current_true;
     }
     out.push_back({scenario_.rendering.start_stamp + t, pose});
   }

@@ -22,6 +22,7 @@
 #include "online_stereo_calibration/StereoCalibration.h"
 #include "online_stereo_calibration/core/geometry/camera_model.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
+#include "online_stereo_calibration/ros/conversions.h"
 #include "online_stereo_calibration/tools/pose_interpolation.h"
 
 namespace osc::bag {
@@ -42,29 +43,6 @@ struct DriveTopics {
   std::string right_frame = "right_camera_optical";
 };
 
-inline geometry_msgs::Transform toTransform(const Eigen::Isometry3d& T) {
-  geometry_msgs::Transform out;
-  out.translation.x = T.translation().x();
-  out.translation.y = T.translation().y();
-  out.translation.z = T.translation().z();
-  const Eigen::Quaterniond q(T.rotation());
-  out.rotation.x = q.x();
-  out.rotation.y = q.y();
-  out.rotation.z = q.z();
-  out.rotation.w = q.w();
-  return out;
-}
-
-inline Eigen::Isometry3d fromPose(const geometry_msgs::Pose& pose) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(pose.orientation.w, pose.orientation.x, pose.orientation.y,
-                                  pose.orientation.z)
-                   .normalized()
-                   .toRotationMatrix();
-  T.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
-  return T;
-}
-
 /// sensor_msgs/CameraInfo of unrectified intrinsics: K, D, distortion_model, R = I,
 /// P = [K | 0] (the left camera's convention for a raw stream).
 inline sensor_msgs::CameraInfo toCameraInfo(const CameraIntrinsics& c, const ros::Time& stamp,
@@ -84,26 +62,6 @@ inline sensor_msgs::CameraInfo toCameraInfo(const CameraIntrinsics& c, const ros
   return info;
 }
 
-/// The intrinsics in a CameraInfo (K, D, distortion_model, size). All-zero D means none.
-inline CameraIntrinsics fromCameraInfo(const sensor_msgs::CameraInfo& info) {
-  CameraIntrinsics c;
-  c.width = static_cast<int>(info.width);
-  c.height = static_cast<int>(info.height);
-  c.fx = info.K[0];
-  c.fy = info.K[4];
-  c.cx = info.K[2];
-  c.cy = info.K[5];
-  bool all_zero = true;
-  for (double d : info.D) all_zero = all_zero && d == 0.0;
-  if (info.D.empty() || all_zero) {
-    c.model = DistortionModel::kNone;
-  } else {
-    c.model = distortionModelFromName(info.distortion_model);
-    c.distortion = info.D;
-  }
-  return c;
-}
-
 /// A StereoCalibration message of known parameters (covariance and sigma zero): the truth.
 inline online_stereo_calibration::StereoCalibration toCalibrationMessage(
     const Vector12d& parameters, const ros::Time& stamp, const DriveTopics& names) {
@@ -113,8 +71,8 @@ inline online_stereo_calibration::StereoCalibration toCalibrationMessage(
   msg.left_frame_id = names.left_frame;
   msg.right_frame_id = names.right_frame;
   const StereoExtrinsics e = StereoExtrinsics::fromParameters(parameters);
-  msg.vehicle_to_left = toTransform(e.vehicleToLeftOptical());
-  msg.left_to_right = toTransform(e.leftToRightOptical());
+  msg.vehicle_to_left = online_stereo_calibration::transformFromIsometry(e.vehicleToLeftOptical());
+  msg.left_to_right = online_stereo_calibration::transformFromIsometry(e.leftToRightOptical());
   for (int i = 0; i < 12; ++i) msg.parameters[i] = parameters(i);
   msg.state = online_stereo_calibration::StereoCalibration::STATE_CONVERGED;
   return msg;
@@ -126,7 +84,7 @@ inline nav_msgs::Odometry toOdometry(const StampedPose& pose, const DriveTopics&
   msg.header.stamp.fromSec(pose.stamp);
   msg.header.frame_id = names.odom_frame;
   msg.child_frame_id = names.vehicle_frame;
-  const geometry_msgs::Transform t = toTransform(pose.pose);
+  const geometry_msgs::Transform t = online_stereo_calibration::transformFromIsometry(pose.pose);
   msg.pose.pose.position.x = t.translation.x;
   msg.pose.pose.position.y = t.translation.y;
   msg.pose.pose.position.z = t.translation.z;
@@ -140,7 +98,9 @@ inline PoseTrajectory readOdometry(const rosbag::Bag& bag, const std::string& to
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   for (const rosbag::MessageInstance& m : view) {
     const auto odom = m.instantiate<nav_msgs::Odometry>();
-    if (odom) poses.push_back({odom->header.stamp.toSec(), fromPose(odom->pose.pose)});
+    if (odom)
+      poses.push_back({odom->header.stamp.toSec(),
+                       online_stereo_calibration::isometryFromPose(odom->pose.pose)});
   }
   std::stable_sort(poses.begin(), poses.end(),
                    [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });

@@ -152,7 +152,7 @@ osc::CameraIntrinsics readCameraInfo(const rosbag::Bag& bag, const std::string& 
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   for (const rosbag::MessageInstance& m : view) {
     const auto info = m.instantiate<sensor_msgs::CameraInfo>();
-    if (info) return osc::bag::fromCameraInfo(*info);
+    if (info) return online_stereo_calibration::intrinsicsFromCameraInfo(*info);  // validated
   }
   throw std::runtime_error("no sensor_msgs/CameraInfo on " + topic);
 }
