@@ -16,37 +16,22 @@ using diagnostic_msgs::DiagnosticStatus;
 TEST(NoCameraInfo, IsAnErrorInDiagnosticsAndNothingIsPublished) {
   ros::NodeHandle nh;
   const std::string node = "online_stereo_calibration";
-  auto left = nh.advertise<sensor_msgs::Image>("left/image_raw", 10);
-  auto right = nh.advertise<sensor_msgs::Image>("right/image_raw", 10);
-  auto left_info = nh.advertise<sensor_msgs::CameraInfo>("left/camera_info", 10);
-  auto right_info = nh.advertise<sensor_msgs::CameraInfo>("right/camera_info", 10);
-  auto odom = nh.advertise<nav_msgs::Odometry>("odom", 100);
+  osc_test::StereoInputs in(nh);
   osc_test::CalibrationCollector calibrations(nh, node + "/calibration");
   osc_test::DiagnosticsCollector diagnostics(nh);
-  ASSERT_TRUE(osc_test::spinUntil(
-      [&]() {
-        return left.getNumSubscribers() > 0 && left_info.getNumSubscribers() > 0 &&
-               odom.getNumSubscribers() > 0;
-      },
-      10.0));
+  ASSERT_TRUE(in.waitForSubscribers(10.0));
   const cv::Mat texture = osc_test::randomTexture();
   const double t0 = ros::Time::now().toSec();
   size_t mark = 0;
   const auto publishFrame = [&](int k, bool with_info) {
     const double t = t0 + 0.1 * k;
-    for (int j = 0; j < 5; ++j) {
-      nav_msgs::Odometry o;
-      o.header.stamp = ros::Time(t + 0.02 * j);
-      o.pose.pose.position.x = 2.0 * (t + 0.02 * j - t0);
-      o.pose.pose.orientation.w = 1.0;
-      odom.publish(o);
-    }
+    for (int j = 0; j < 5; ++j) in.odom.publish(osc_test::straightDriveOdometry(t0, t + 0.02 * j));
     const ros::Time stamp(t);
-    left.publish(osc_test::textureImage(texture, 200 + 2 * k, stamp, "left_optical", "mono8"));
-    right.publish(osc_test::textureImage(texture, 190 + 2 * k, stamp, "right_optical", "mono8"));
+    in.left.publish(osc_test::textureImage(texture, 200 + 2 * k, stamp, "left_optical", "mono8"));
+    in.right.publish(osc_test::textureImage(texture, 190 + 2 * k, stamp, "right_optical", "mono8"));
     if (with_info) {
-      left_info.publish(osc_test::pinholeInfo(stamp, "left_optical"));
-      right_info.publish(osc_test::pinholeInfo(stamp, "right_optical"));
+      in.left_info.publish(osc_test::pinholeInfo(stamp, "left_optical"));
+      in.right_info.publish(osc_test::pinholeInfo(stamp, "right_optical"));
     }
     osc_test::spinUntil([]() { return false; }, 0.1);
   };

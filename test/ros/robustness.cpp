@@ -29,15 +29,10 @@ TEST(Robustness, AwkwardInputIsDiagnosedAndNeverKillsTheNodeNorPublishesNaN) {
   ros::param::get("~node", node);
   std::string file;
   ros::param::get("~calibration_file", file);
-  auto left = nh.advertise<sensor_msgs::Image>("left/image_raw", 10);
-  auto right = nh.advertise<sensor_msgs::Image>("right/image_raw", 10);
-  auto left_info = nh.advertise<sensor_msgs::CameraInfo>("left/camera_info", 10);
-  auto right_info = nh.advertise<sensor_msgs::CameraInfo>("right/camera_info", 10);
-  auto odom = nh.advertise<nav_msgs::Odometry>("odom", 100);
+  osc_test::StereoInputs in(nh);
   osc_test::CalibrationCollector calibrations(nh, node + "/calibration");
   osc_test::DiagnosticsCollector diagnostics(nh);
-  ASSERT_TRUE(osc_test::spinUntil(
-      [&]() { return left.getNumSubscribers() > 0 && odom.getNumSubscribers() > 0; }, 10.0));
+  ASSERT_TRUE(in.waitForSubscribers(10.0));
   const cv::Mat texture = osc_test::randomTexture();
   const double t0 = ros::Time::now().toSec();
   ros::Time last_before_loop;
@@ -46,12 +41,9 @@ TEST(Robustness, AwkwardInputIsDiagnosedAndNeverKillsTheNodeNorPublishesNaN) {
     const double t = t0 + 0.1 * drive_k;
     if (k < 22 || k > 46) {
       for (int j = 0; j < 5; ++j) {
-        nav_msgs::Odometry o;
-        o.header.stamp = ros::Time(t + 0.02 * j);
-        o.pose.pose.position.x = 2.0 * (t + 0.02 * j - t0);
-        o.pose.pose.orientation.w = 1.0;
+        nav_msgs::Odometry o = osc_test::straightDriveOdometry(t0, t + 0.02 * j);
         if (k == 12 && j == 0) o.pose.pose.position.y = std::nan("");
-        odom.publish(o);
+        in.odom.publish(o);
       }
     }
     ros::Time stamp(t);
@@ -59,11 +51,11 @@ TEST(Robustness, AwkwardInputIsDiagnosedAndNeverKillsTheNodeNorPublishesNaN) {
     if (k == 50) stamp = ros::Time(t - 2.0);
     const std::string encoding = k == 8 ? "yuv422" : "mono8";
     const int shift = 2 * drive_k;
-    left.publish(textureImage(texture, 200 + shift, stamp, "left_optical", encoding));
-    right.publish(textureImage(texture, 190 + shift, stamp, "right_optical", encoding));
-    left_info.publish(pinholeInfo(stamp, "left_optical"));
-    right_info.publish(k == 18 || k == 19 ? pinholeInfo(stamp, "right_optical", 640, 480)
-                                          : pinholeInfo(stamp, "right_optical"));
+    in.left.publish(textureImage(texture, 200 + shift, stamp, "left_optical", encoding));
+    in.right.publish(textureImage(texture, 190 + shift, stamp, "right_optical", encoding));
+    in.left_info.publish(pinholeInfo(stamp, "left_optical"));
+    in.right_info.publish(k == 18 || k == 19 ? pinholeInfo(stamp, "right_optical", 640, 480)
+                                             : pinholeInfo(stamp, "right_optical"));
     if (k == 59) last_before_loop = stamp;
     osc_test::spinUntil([]() { return false; }, 0.1);
     // Checkpoints at ordinary pairs: the worker may lag on a loaded machine; let it catch up

@@ -167,6 +167,35 @@ class CalibrationCollector {
   std::vector<StereoCalibration> messages_;
 };
 
+/// Publishers of the node's inputs (interface.md topics, relative to the test's namespace).
+struct StereoInputs {
+  explicit StereoInputs(ros::NodeHandle& nh)
+      : left(nh.advertise<sensor_msgs::Image>("left/image_raw", 10)),
+        right(nh.advertise<sensor_msgs::Image>("right/image_raw", 10)),
+        left_info(nh.advertise<sensor_msgs::CameraInfo>("left/camera_info", 10)),
+        right_info(nh.advertise<sensor_msgs::CameraInfo>("right/camera_info", 10)),
+        odom(nh.advertise<nav_msgs::Odometry>("odom", 100)) {}
+  /// Waits until the node subscribes to the images, camera_info and odometry.
+  bool waitForSubscribers(double timeout) const {
+    return spinUntil(
+        [&]() {
+          return left.getNumSubscribers() > 0 && left_info.getNumSubscribers() > 0 &&
+                 odom.getNumSubscribers() > 0;
+        },
+        timeout);
+  }
+  ros::Publisher left, right, left_info, right_info, odom;
+};
+
+/// Odometry of a straight drive at 2 m/s along x that started at @p t0 (s), at time @p t.
+inline nav_msgs::Odometry straightDriveOdometry(double t0, double t) {
+  nav_msgs::Odometry o;
+  o.header.stamp = ros::Time(t);
+  o.pose.pose.position.x = 2.0 * (t - t0);
+  o.pose.pose.orientation.w = 1.0;
+  return o;
+}
+
 /// A 320x240 window of a random texture shifted by @p x (cheap, not a 3D scene).
 inline sensor_msgs::Image textureImage(const cv::Mat& texture, int x, const ros::Time& stamp,
                                        const std::string& frame, const std::string& encoding) {
