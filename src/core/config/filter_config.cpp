@@ -50,9 +50,12 @@ void ParameterSpec::set(FilterConfig* config, double file_value) const {
 const std::vector<ParameterSpec>& filterParameterTable() {
   using C = FilterConfig;
   static const std::vector<ParameterSpec> table = {
-      real("ut_alpha", &C::ut_alpha, 1.0, 1e-3, 1.0, "scaled unscented transform: sigma-point spread"),
-      real("ut_beta", &C::ut_beta, 1.0, 0.0, 10.0, "scaled unscented transform: 2 for Gaussian priors"),
-      real("ut_kappa", &C::ut_kappa, 1.0, 0.0, 10.0, "scaled unscented transform: secondary scaling"),
+      real("ut_alpha", &C::ut_alpha, 1.0, 1e-3, 1.0,
+           "scaled unscented transform: sigma-point spread"),
+      real("ut_beta", &C::ut_beta, 1.0, 0.0, 10.0,
+           "scaled unscented transform: 2 for Gaussian priors"),
+      real("ut_kappa", &C::ut_kappa, 1.0, 0.0, 10.0,
+           "scaled unscented transform: secondary scaling"),
       real("reference_period_s", &C::reference_period, 1.0, 1e-3, 10.0,
            "step length the per-step noise sigmas refer to (paper: 0.1 s at 10 Hz)"),
       real("caml_translation_drift_m", &C::caml_translation_drift, 1.0, 0.0, 1.0,
@@ -122,8 +125,8 @@ std::vector<std::string> FilterConfig::validate() const {
   }
   if (min_point_depth >= max_point_depth) {
     std::ostringstream message;
-    message << "min_point_depth_m = " << min_point_depth << " must be below max_point_depth_m = "
-            << max_point_depth;
+    message << "min_point_depth_m = " << min_point_depth
+            << " must be below max_point_depth_m = " << max_point_depth;
     problems.push_back(message.str());
   }
   return problems;
@@ -142,7 +145,8 @@ std::string motionNoiseModelName(MotionNoiseModel model) {
 
 FilterConfig paperFilterConfig() {
   FilterConfig config;
-  config.point_position_noise = 0.2;  // eq. 14
+  config.point_position_noise = 0.2;        // eq. 14
+  config.camr_translation_drift = 0.01e-3;  // eq. 12
   config.motion_noise_model = MotionNoiseModel::kPerPoint;
   config.motion_translation_noise = 0.0;  // "not considered in this paper"
   config.motion_excitation_window = 0.0;  // the paper linearises at the measured motion
