@@ -59,9 +59,10 @@ struct DriveFigures {
 };
 
 DriveFigures drive(const MeasurementScenario& scenario, const FilterConfig& filter,
-                   const FrontEndConfig& front_end) {
+                   const FrontEndConfig& front_end, const ImageScenarioOptions& options = {}) {
   DriveFigures f;
-  const std::vector<ImageFrameResult> results = runImageScenario(scenario, filter, front_end);
+  const std::vector<ImageFrameResult> results =
+      runImageScenario(scenario, filter, front_end, options);
   for (const ImageFrameResult& r : results) {
     f.matches += r.matches_checked;
     f.matches_correct += r.matches_correct;
@@ -135,6 +136,29 @@ TEST(FrontEnd, MatchesAndTracksAreCorrectOnRenderedDrive) {
   const int frames = 25;
   const DriveFigures f = drive(shortDrive(frames), confidentConfig(), FrontEndConfig());
   expectGoodDrive(f, frames, 0.99);
+}
+
+TEST(FrontEnd, NoisyBlurredFlickeringImages) {
+  // A poorer camera than the bags' (1 grey level, 0.5 px): sensor noise of 3 grey levels,
+  // 0.8 px optical blur, and auto-exposure flicker of +-10 % per image, independently left
+  // and right. Measured (20 frames): stereo matches 99.06 % correct, new points 97.2 %, tracks
+  // 89.7 % stereo-correct and 91.8 % on their birth point, 63 points alive. Each alone
+  // (noise 3 / blur 0.8 / flicker 20 %): tracks 96.3 / 94.3 / 98.1 % stereo-correct; flicker
+  // of 20 % leaves 47 points. NOT AT TARGET: tracks under noise plus blur (99 % wanted).
+  const int frames = 20;
+  ImageScenarioOptions poor;
+  poor.render.noise_sigma = 3.0;
+  poor.render.blur_sigma = 0.8;
+  poor.exposure_variation = 0.1;
+  const DriveFigures f = drive(shortDrive(frames), confidentConfig(), FrontEndConfig(), poor);
+  EXPECT_EQ(f.processed, frames);
+  EXPECT_GE(f.matches, 100 * frames);
+  EXPECT_GE(f.matches_correct, 0.985 * f.matches);
+  EXPECT_GE(f.new_correct, 0.96 * f.new_points);
+  EXPECT_GE(f.tracks, 20 * frames);
+  EXPECT_GE(f.tracks_stereo_correct, 0.87 * f.tracks_reported);
+  EXPECT_GE(f.tracks_correct, 0.89 * f.tracks);
+  EXPECT_GE(f.final_points, 50);
 }
 
 TEST(FrontEnd, SearchingLostTracksKeepsMoreTracksAtTheSameStereoPrecision) {

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <random>
 #include <unordered_map>
 
 #include <Eigen/Cholesky>
@@ -54,8 +55,13 @@ std::vector<ImageFrameResult> runImageScenario(
     const auto render_start = std::chrono::steady_clock::now();
     RenderOptions render = options.render;
     render.noise_seed = 2u * static_cast<unsigned>(frame.index) + 1u;
+    std::mt19937 exposure_rng(render.noise_seed);
+    std::uniform_real_distribution<double> flicker(1.0 - options.exposure_variation,
+                                                   1.0 + options.exposure_variation);
+    render.exposure_gain = options.render.exposure_gain * flicker(exposure_rng);
     const cv::Mat left = renderer.render(left_camera, T_world_lopt, render);
     render.noise_seed += 1u;
+    render.exposure_gain = options.render.exposure_gain * flicker(exposure_rng);
     const cv::Mat right = renderer.render(right_camera, T_world_ropt, render);
     r.render_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - render_start)
@@ -100,7 +106,8 @@ std::vector<ImageFrameResult> runImageScenario(
     }
     for (PointId id : result.estimator.dropped) birth_points.erase(id);
 
-    r.filter = makeFrameResult(frame, result.estimate, result.estimator, 1e3 * result.processing_time);
+    r.filter =
+        makeFrameResult(frame, result.estimate, result.estimator, 1e3 * result.processing_time);
     if (on_frame) on_frame(r, pipeline);
     results.push_back(r);
   }

@@ -24,6 +24,10 @@ struct ImageScenarioOptions {
   SceneConfig scene;
   /// Rendering of every image; noise_seed is replaced by a per-frame, per-camera seed.
   RenderOptions render;
+  /// Auto-exposure flicker: each image's exposure_gain is render.exposure_gain times a factor
+  /// drawn uniformly from [1 - v, 1 + v], independently per frame and camera (seeded by the
+  /// frame index, so a run is reproducible). 0 = every image as render says.
+  double exposure_variation = 0.0;
   /// A match or track is correct within this distance (px) of the true projection.
   double correct_tolerance = 1.5;
   /// Check the correctness of every stereo match (before bucketing), not only of the
