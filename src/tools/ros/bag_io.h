@@ -92,37 +92,58 @@ inline nav_msgs::Odometry toOdometry(const StampedPose& pose, const DriveTopics&
   return msg;
 }
 
-/// Every pose of an odometry topic, in stamp order (out-of-order messages are sorted).
-inline PoseTrajectory readOdometry(const rosbag::Bag& bag, const std::string& topic) {
+/// The odometry and StereoCalibration messages of a bag.
+struct OdometryAndCalibration {
+  /// Every pose of the odometry topic, in stamp order (out-of-order messages are sorted).
+  PoseTrajectory odometry;
+  /// The parameters of every StereoCalibration message: (header stamp in ns, parameters), in
+  /// bag order.
+  std::vector<std::pair<std::int64_t, Vector12d>> calibration;
+};
+
+/// Reads both topics in one pass over the bag (an empty topic name is skipped): rosbag reads
+/// whole chunks, and odometry and truth are spread over every chunk of an image bag, so a view
+/// per topic would read the whole bag once per topic.
+inline OdometryAndCalibration readOdometryAndCalibration(const rosbag::Bag& bag,
+                                                         const std::string& odom_topic,
+                                                         const std::string& calibration_topic) {
+  std::vector<std::string> topics;
+  for (const std::string& topic : {odom_topic, calibration_topic}) {
+    if (!topic.empty()) topics.push_back(topic);
+  }
+  OdometryAndCalibration out;
   std::vector<StampedPose> poses;
-  rosbag::View view(bag, rosbag::TopicQuery(topic));
+  rosbag::View view(bag, rosbag::TopicQuery(topics));
   for (const rosbag::MessageInstance& m : view) {
-    const auto odom = m.instantiate<nav_msgs::Odometry>();
-    if (odom)
-      poses.push_back({odom->header.stamp.toSec(),
-                       online_stereo_calibration::isometryFromPose(odom->pose.pose)});
+    if (!odom_topic.empty() && m.getTopic() == odom_topic) {
+      const auto odom = m.instantiate<nav_msgs::Odometry>();
+      if (odom)
+        poses.push_back({odom->header.stamp.toSec(),
+                         online_stereo_calibration::isometryFromPose(odom->pose.pose)});
+    }
+    if (!calibration_topic.empty() && m.getTopic() == calibration_topic) {
+      const auto msg = m.instantiate<online_stereo_calibration::StereoCalibration>();
+      if (!msg) continue;
+      Vector12d p;
+      for (int i = 0; i < 12; ++i) p(i) = msg->parameters[i];
+      out.calibration.emplace_back(static_cast<std::int64_t>(msg->header.stamp.toNSec()), p);
+    }
   }
   std::stable_sort(poses.begin(), poses.end(),
                    [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
-  PoseTrajectory trajectory;
-  for (const StampedPose& p : poses) trajectory.append(p.stamp, p.pose);
-  return trajectory;
+  for (const StampedPose& p : poses) out.odometry.append(p.stamp, p.pose);
+  return out;
 }
 
-/// The parameters of every StereoCalibration message on a topic: (header stamp in ns,
-/// parameters), in bag order.
+/// Every pose of an odometry topic, in stamp order.
+inline PoseTrajectory readOdometry(const rosbag::Bag& bag, const std::string& topic) {
+  return readOdometryAndCalibration(bag, topic, "").odometry;
+}
+
+/// The parameters of every StereoCalibration message on a topic, in bag order.
 inline std::vector<std::pair<std::int64_t, Vector12d>> readCalibrationTopic(
     const rosbag::Bag& bag, const std::string& topic) {
-  std::vector<std::pair<std::int64_t, Vector12d>> out;
-  rosbag::View view(bag, rosbag::TopicQuery(topic));
-  for (const rosbag::MessageInstance& m : view) {
-    const auto msg = m.instantiate<online_stereo_calibration::StereoCalibration>();
-    if (!msg) continue;
-    Vector12d p;
-    for (int i = 0; i < 12; ++i) p(i) = msg->parameters[i];
-    out.emplace_back(static_cast<std::int64_t>(msg->header.stamp.toNSec()), p);
-  }
-  return out;
+  return readOdometryAndCalibration(bag, "", topic).calibration;
 }
 
 /// The scenario fingerprint stored in a bag by `simulate`, or "" (no such topic, unreadable).

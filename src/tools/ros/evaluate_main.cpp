@@ -26,6 +26,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include <cv_bridge/cv_bridge.h>
 #include <ros/package.h>
@@ -157,41 +158,6 @@ osc::CameraIntrinsics readCameraInfo(const rosbag::Bag& bag, const std::string& 
   throw std::runtime_error("no sensor_msgs/CameraInfo on " + topic);
 }
 
-/// The odometry (as bag_io.h's readOdometry) and, with a truth topic, the per-frame truth
-/// (as readCalibrationTopic, keyed by stamp) in one pass over the bag: rosbag reads whole
-/// chunks, and odometry and truth are spread over every chunk of the (image-sized) bag, so
-/// two separate views read the whole bag twice.
-osc::PoseTrajectory readOdometryAndTruth(const rosbag::Bag& bag, const std::string& odom_topic,
-                                         const std::string& truth_topic,
-                                         std::map<std::int64_t, osc::Vector12d>* truth) {
-  std::vector<std::string> wanted = {odom_topic};
-  if (!truth_topic.empty() && truth_topic != odom_topic) wanted.push_back(truth_topic);
-  std::vector<osc::StampedPose> poses;
-  rosbag::View view(bag, rosbag::TopicQuery(wanted));
-  for (const rosbag::MessageInstance& m : view) {
-    const std::string& topic = m.getTopic();
-    if (topic == odom_topic) {
-      const auto odom = m.instantiate<nav_msgs::Odometry>();
-      if (odom)
-        poses.push_back({odom->header.stamp.toSec(),
-                         online_stereo_calibration::isometryFromPose(odom->pose.pose)});
-    }
-    if (!truth_topic.empty() && topic == truth_topic) {
-      const auto msg = m.instantiate<online_stereo_calibration::StereoCalibration>();
-      if (!msg) continue;
-      osc::Vector12d p;
-      for (int i = 0; i < 12; ++i) p(i) = msg->parameters[i];
-      (*truth)[static_cast<std::int64_t>(msg->header.stamp.toNSec())] = p;
-    }
-  }
-  std::stable_sort(
-      poses.begin(), poses.end(),
-      [](const osc::StampedPose& a, const osc::StampedPose& b) { return a.stamp < b.stamp; });
-  osc::PoseTrajectory trajectory;
-  for (const osc::StampedPose& p : poses) trajectory.append(p.stamp, p.pose);
-  return trajectory;
-}
-
 std::string quote(const std::string& s) { return "'" + s + "'"; }
 
 /// The tool itself, after the command line.
@@ -227,9 +193,12 @@ int evaluateBag(const Options& options) {
   osc::makeDirectories(options.out);
   const osc::CameraIntrinsics left_camera = readCameraInfo(bag, topics.left_info);
   const osc::CameraIntrinsics right_camera = readCameraInfo(bag, topics.right_info);
-  std::map<std::int64_t, osc::Vector12d> truth;
-  const osc::PoseTrajectory odometry =
-      readOdometryAndTruth(bag, topics.odom, options.truth_topic, &truth);
+  // One pass over the bag for both (see readOdometryAndCalibration).
+  osc::bag::OdometryAndCalibration inputs =
+      osc::bag::readOdometryAndCalibration(bag, topics.odom, options.truth_topic);
+  const osc::PoseTrajectory odometry = std::move(inputs.odometry);
+  std::map<std::int64_t, osc::Vector12d> truth;  // the latest message of a stamp wins
+  for (const auto& [stamp, parameters] : inputs.calibration) truth[stamp] = parameters;
   if (odometry.size() < 2)
     throw std::runtime_error("fewer than 2 odometry poses on " + topics.odom);
   if (!options.truth_topic.empty() && truth.empty()) {
