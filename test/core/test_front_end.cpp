@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -151,6 +152,10 @@ TEST(FrontEnd, NoisyBlurredFlickeringImages) {
   poor.render.blur_sigma = 0.8;
   poor.exposure_variation = 0.1;
   const DriveFigures f = drive(shortDrive(frames), confidentConfig(), FrontEndConfig(), poor);
+  ImageScenarioOptions negative_gain;
+  negative_gain.exposure_variation = 1.2;
+  EXPECT_THROW(runImageScenario(shortDrive(1), confidentConfig(), FrontEndConfig(), negative_gain),
+               std::invalid_argument);
   EXPECT_EQ(f.processed, frames);
   EXPECT_GE(f.matches, 100 * frames);
   EXPECT_GE(f.matches_correct, 0.985 * f.matches);

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <unordered_map>
 
 #include <Eigen/Cholesky>
@@ -28,6 +30,11 @@ std::vector<ImageFrameResult> runImageScenario(
     const MeasurementScenario& scenario, const FilterConfig& filter_config,
     const FrontEndConfig& front_end_config, const ImageScenarioOptions& options,
     const std::function<void(const ImageFrameResult&, const CalibrationPipeline&)>& on_frame) {
+  if (!(options.exposure_variation >= 0.0 && options.exposure_variation < 1.0)) {
+    throw std::invalid_argument(
+        "ImageScenarioOptions.exposure_variation = " + std::to_string(options.exposure_variation) +
+        " must be in [0, 1) (a gain factor 1 +- v must stay positive)");
+  }
   MeasurementSimulator simulator(scenario);  // motion noise, truth and poses
   const VehicleTrajectory& trajectory = simulator.trajectory();
   SceneConfig scene = options.scene;

@@ -67,7 +67,7 @@ bool isCorrectStereoMatch(const StereoSceneRenderer& renderer, const CameraModel
 /// truth and the vehicle poses come from a MeasurementSimulator of the same scenario (its
 /// motion noise stream), so both runners see identical motion errors. on_frame is called
 /// after each frame if given.
-/// @throws std::invalid_argument for an invalid scenario or config.
+/// @throws std::invalid_argument for an invalid scenario, config or exposure_variation.
 std::vector<ImageFrameResult> runImageScenario(
     const MeasurementScenario& scenario, const FilterConfig& filter_config,
     const FrontEndConfig& front_end_config, const ImageScenarioOptions& options = {},
