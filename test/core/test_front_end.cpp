@@ -55,6 +55,8 @@ struct DriveFigures {
   int tracks = 0, tracks_correct = 0;
   int tracks_reported = 0, tracks_stereo_correct = 0;
   int new_points = 0, new_correct = 0;
+  int matches_at_pixel = 0, new_at_pixel = 0, tracks_stereo_at_pixel = 0;
+  int tracks_at_birth_pixel = 0;
   int final_points = 0;
   int processed = 0;
 };
@@ -73,6 +75,10 @@ DriveFigures drive(const MeasurementScenario& scenario, const FilterConfig& filt
     f.tracks_stereo_correct += r.tracks_stereo_correct;
     f.new_points += r.new_checked;
     f.new_correct += r.new_correct;
+    f.matches_at_pixel += r.matches_correct_at_pixel;
+    f.new_at_pixel += r.new_correct_at_pixel;
+    f.tracks_stereo_at_pixel += r.tracks_stereo_correct_at_pixel;
+    f.tracks_at_birth_pixel += r.tracks_correct_at_birth_pixel;
     f.processed += r.processed;
   }
   f.final_points = results.back().filter.tracked_points;
@@ -83,28 +89,29 @@ DriveFigures drive(const MeasurementScenario& scenario, const FilterConfig& filt
       100.0 * f.new_correct / std::max(1, f.new_points), f.tracks_reported,
       100.0 * f.tracks_stereo_correct / std::max(1, f.tracks_reported),
       100.0 * f.tracks_correct / std::max(1, f.tracks), f.final_points);
+  std::printf(
+      "  at the exact left pixel: matches %.2f %%, new %.2f %%, tracks %.2f %% (%.2f %% on the "
+      "point of their birth pixel)\n",
+      100.0 * f.matches_at_pixel / std::max(1, f.matches),
+      100.0 * f.new_at_pixel / std::max(1, f.new_points),
+      100.0 * f.tracks_stereo_at_pixel / std::max(1, f.tracks_reported),
+      100.0 * f.tracks_at_birth_pixel / std::max(1, f.tracks));
   return f;
 }
 
-/// Bars of a rendered drive. The targets are >= 99 % correct stereo matches and
-/// tracks and >= 50 points alive.
-/// - Stereo matches (every match that passed the checks of a new point): >= 99 % on the
-///   pinhole drive (measured 99.3 %); 98.5 % with distorted lenses (measured 99.0 %).
-/// - NOT YET AT TARGET: tracks (stereo pair correct: measured 95-96.6 %; still on their
-///   birth point: 94-95 %) and new points (97.5-98.5 %). Nearly every remaining wrong track
-///   is a keypoint on an occluding contour: the pixel sees the sky or a distant featureless
-///   surface while the feature is the outline of a nearer object (cone tips, box tops), so
-///   the pixel's own surface point does not project where the right feature is. Neither the
-///   patch NCC nor the split-patch disparity check sees it (the background has no texture).
-///   The bars are the measured figures minus a margin.
-void expectGoodDrive(const DriveFigures& f, int frames, double match_precision) {
+/// The targets on a rendered drive: >= 99 % correct stereo matches, new points and
+/// tracks (stereo pair correct in the frame, and still on a scene point of their birth match),
+/// and >= 50 points alive. "Correct" is ImageFrameResult's: one scene point within 1.5 px of
+/// both pixels. The stricter figures at the exact left pixel are printed, not asserted: they
+/// also fail correct matches of outlines whose keypoint lies a pixel off the object.
+void expectGoodDrive(const DriveFigures& f, int frames, double track_precision = 0.99) {
   EXPECT_EQ(f.processed, frames);
   EXPECT_GE(f.matches, 100 * frames);
-  EXPECT_GE(f.matches_correct, match_precision * f.matches);
-  EXPECT_GE(f.new_correct, 0.96 * f.new_points);
+  EXPECT_GE(f.matches_correct, 0.99 * f.matches);
+  EXPECT_GE(f.new_correct, 0.99 * f.new_points);
   EXPECT_GE(f.tracks, 25 * frames);
-  EXPECT_GE(f.tracks_correct, 0.92 * f.tracks);
-  EXPECT_GE(f.tracks_stereo_correct, 0.93 * f.tracks_reported);
+  EXPECT_GE(f.tracks_stereo_correct, 0.99 * f.tracks_reported);
+  EXPECT_GE(f.tracks_correct, track_precision * f.tracks);
   EXPECT_GE(f.final_points, 50);
 }
 
@@ -134,18 +141,19 @@ TEST(Bucketing, KeepsTheBestPerFreeCellUpToTheCap) {
 }
 
 TEST(FrontEnd, MatchesAndTracksAreCorrectOnRenderedDrive) {
-  const int frames = 25;
+  const int frames = 60;
   const DriveFigures f = drive(shortDrive(frames), confidentConfig(), FrontEndConfig());
-  expectGoodDrive(f, frames, 0.99);
+  expectGoodDrive(f, frames);
 }
 
 TEST(FrontEnd, NoisyBlurredFlickeringImages) {
   // A poorer camera than the bags' (1 grey level, 0.5 px): sensor noise of 3 grey levels,
   // 0.8 px optical blur, and auto-exposure flicker of +-10 % per image, independently left
-  // and right. Measured (20 frames): stereo matches 99.06 % correct, new points 97.2 %, tracks
-  // 89.7 % stereo-correct and 91.8 % on their birth point, 63 points alive. Each alone
-  // (noise 3 / blur 0.8 / flicker 20 %): tracks 96.3 / 94.3 / 98.1 % stereo-correct; flicker
-  // of 20 % leaves 47 points. NOT AT TARGET: tracks under noise plus blur (99 % wanted).
+  // and right. Measured (20 frames): stereo matches 99.80 % correct, new points 98.99 %,
+  // tracks 94.25 % stereo-correct and 93.36 % on their birth point, 61 points alive.
+  // NOT AT TARGET: tracks (99 % wanted). The wrong ones are keypoints the noise makes in the
+  // sky a few pixels off an object's outline: the patch is the outline's, so the pair is
+  // consistent every frame with the object's disparity but the pixel is 2-6 px off it.
   const int frames = 20;
   ImageScenarioOptions poor;
   poor.render.noise_sigma = 3.0;
@@ -158,44 +166,49 @@ TEST(FrontEnd, NoisyBlurredFlickeringImages) {
                std::invalid_argument);
   EXPECT_EQ(f.processed, frames);
   EXPECT_GE(f.matches, 100 * frames);
-  EXPECT_GE(f.matches_correct, 0.985 * f.matches);
-  EXPECT_GE(f.new_correct, 0.96 * f.new_points);
+  EXPECT_GE(f.matches_correct, 0.99 * f.matches);
+  EXPECT_GE(f.new_correct, 0.98 * f.new_points);
   EXPECT_GE(f.tracks, 20 * frames);
-  EXPECT_GE(f.tracks_stereo_correct, 0.87 * f.tracks_reported);
-  EXPECT_GE(f.tracks_correct, 0.89 * f.tracks);
+  EXPECT_GE(f.tracks_stereo_correct, 0.92 * f.tracks_reported);
+  EXPECT_GE(f.tracks_correct, 0.91 * f.tracks);
   EXPECT_GE(f.final_points, 50);
 }
 
 TEST(FrontEnd, SearchingLostTracksKeepsMoreTracksAtTheSameStereoPrecision) {
-  // Off by default: measured (20 frames) 1165 tracks instead of 590 and stereo pairs 97.1 %
-  // correct (96.6 % without), but only 92.2 % on their birth point (94.4 %): LK from the
-  // prediction lets tracks on the near ground drift.
+  // Off by default: measured (20 frames) 1206 tracks instead of 604, 99.92 % stereo-correct
+  // and 99.50 % on their birth point (with the anchor check; 92.2 % before it: LK from the
+  // prediction let tracks on the near ground drift). Not yet measured on the full drives.
   const int frames = 20;
   FrontEndConfig with_search;
   with_search.search_lost_tracks = true;
   const DriveFigures f = drive(shortDrive(frames), confidentConfig(), with_search);
   EXPECT_GE(f.tracks, 50 * frames);
-  EXPECT_GE(f.tracks_stereo_correct, 0.95 * f.tracks_reported);
-  EXPECT_GE(f.tracks_correct, 0.90 * f.tracks);
+  EXPECT_GE(f.tracks_stereo_correct, 0.99 * f.tracks_reported);
+  EXPECT_GE(f.tracks_correct, 0.99 * f.tracks);
   EXPECT_GE(f.final_points, 80);
 }
 
 TEST(FrontEnd, PlumbBobDistortedRawImages) {
-  MeasurementScenario s = shortDrive(20);
+  const int frames = 40;
+  MeasurementScenario s = shortDrive(frames);
   for (CameraIntrinsics* k : {&s.left, &s.right}) {
     k->model = DistortionModel::kPlumbBob;
     k->distortion = {-0.28, 0.074, 0.0002, 0.00002, 0.0};
   }
-  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), 20, 0.985);
+  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), frames);
 }
 
 TEST(FrontEnd, EquidistantDistortedRawImages) {
-  MeasurementScenario s = shortDrive(20);
+  const int frames = 40;
+  MeasurementScenario s = shortDrive(frames);
   for (CameraIntrinsics* k : {&s.left, &s.right}) {
     k->model = DistortionModel::kEquidistant;
     k->distortion = {-0.01, 0.005, -0.002, 0.0};
   }
-  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), 20, 0.985);
+  // NOT AT TARGET: tracks on their birth point 98.35 % (40 frames; the rest >= 99.4 %). The
+  // misses are outlines of far objects against the backdrop that slide along the outline as
+  // the view changes (a consistent pair every frame, but not one surface point).
+  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), frames, 0.98);
 }
 
 TEST(FrontEnd, WrongCalibrationBandStillFindsCorrectMatches) {
@@ -249,6 +262,40 @@ TEST(PatchAlignment, RecoversASubPixelShiftAndBrightnessOffset) {
   config.max_shift = 1.0;
   EXPECT_FALSE(
       alignPatch(source, Eigen::Vector2d(40, 50), target, Eigen::Vector2d(40, 50), config).ok);
+}
+
+TEST(PatchAlignment, ResampledTemplateFollowsAnApproachingSurface) {
+  // target(x) = source((x - c) / s + c): the surface around c appears s times larger, as a
+  // point approached by the camera. The point p (off the centre c) moves to c + s (p - c).
+  const double s = 1.3;
+  const Eigen::Vector2d c(60, 50);
+  const cv::Mat source = texture(120, 100, 7);
+  const cv::Mat M = (cv::Mat_<double>(2, 3) << s, 0, (1 - s) * c.x(), 0, s, (1 - s) * c.y());
+  cv::Mat target;
+  cv::warpAffine(source, target, M, source.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  PatchAlignmentConfig config;
+  config.min_ncc = 0.0;  // compare positions, not the NCC check
+  config.max_shift = 5.0;
+  double error_scaled = 0.0, error_plain = 0.0, ncc_scaled = 0.0, ncc_plain = 0.0;
+  const std::vector<Eigen::Vector2d> points = {{52, 44}, {66.5, 55.2}, {57, 58}, {70, 41}};
+  for (const Eigen::Vector2d& p : points) {
+    const Eigen::Vector2d truth = c + s * (p - c);
+    const Eigen::Vector2d guess = (truth.array() + 0.6).matrix();
+    config.template_scale = s;
+    const PatchAlignment scaled = alignPatch(source, p, target, guess, config);
+    config.template_scale = 1.0;
+    const PatchAlignment plain = alignPatch(source, p, target, guess, config);
+    error_scaled += (scaled.position - truth).norm() / points.size();
+    error_plain += (plain.position - truth).norm() / points.size();
+    ncc_scaled += scaled.ncc / points.size();
+    ncc_plain += plain.ncc / points.size();
+  }
+  EXPECT_LT(error_scaled, 0.1);
+  EXPECT_GT(ncc_scaled, 0.98);
+  EXPECT_GT(ncc_scaled, ncc_plain + 0.02);  // the unscaled template fits the surface worse
+  EXPECT_GT(error_plain, 3.0 * error_scaled);
+  std::printf("  mean error resampled %.3f px (NCC %.3f), unscaled %.3f px (NCC %.3f)\n",
+              error_scaled, ncc_scaled, error_plain, ncc_plain);
 }
 
 TEST(PatchAlignment, RefusesStraightEdgesAndDifferentContent) {
@@ -465,7 +512,8 @@ double diagPair(const DiagCtx& c, const char* tag, const Eigen::Vector2d& pl,
   bool vis = false;
   if (p) vis = c.renderer->projectVisible(*c.right, c.Tr, *p, &proj);
   const double err = p ? (proj - pr).norm() : -1.0;
-  const bool ok = vis && err <= 1.5;
+  const bool ok =
+      checkStereoMatch(*c.renderer, *c.left, *c.right, c.Tl, c.Tr, pl, pr, 1.5).point.has_value();
   if (ok && !print_ok) return err;
   const double depth = diagDepth(c, *c.left, c.Tl, pl);
   std::printf(
@@ -486,14 +534,19 @@ double diagPair(const DiagCtx& c, const char* tag, const Eigen::Vector2d& pl,
 TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
   const int frames = std::getenv("DIAG_FRAMES") ? std::atoi(std::getenv("DIAG_FRAMES")) : 25;
   MeasurementScenario s = shortDrive(frames);
-  if (std::getenv("DIAG_DISTORT")) {
+  if (std::getenv("DIAG_DISTORT")) {  // "equidistant", or anything else for plumb_bob
+    const bool equidistant = std::string(std::getenv("DIAG_DISTORT")) == "equidistant";
     for (CameraIntrinsics* k : {&s.left, &s.right}) {
-      k->model = DistortionModel::kPlumbBob;
-      k->distortion = {-0.28, 0.074, 0.0002, 0.00002, 0.0};
+      k->model = equidistant ? DistortionModel::kEquidistant : DistortionModel::kPlumbBob;
+      k->distortion = equidistant ? std::vector<double>{-0.01, 0.005, -0.002, 0.0}
+                                  : std::vector<double>{-0.28, 0.074, 0.0002, 0.00002, 0.0};
     }
   }
   MeasurementSimulator sim(s);
   ImageScenarioOptions options;
+  if (std::getenv("D_NOISE")) options.render.noise_sigma = std::atof(std::getenv("D_NOISE"));
+  if (std::getenv("D_BLUR")) options.render.blur_sigma = std::atof(std::getenv("D_BLUR"));
+  if (std::getenv("D_FLICKER")) options.exposure_variation = std::atof(std::getenv("D_FLICKER"));
   SceneConfig scene = options.scene;
   scene.path.clear();
   const double duration = s.frames / s.rate_hz;
@@ -521,12 +574,13 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
   envd("D_SNCC", &fe.min_search_ncc);
   envd("D_FB", &fe.max_forward_backward);
   envd("D_EIG", &fe.min_patch_eigen_ratio);
+  envd("D_ANCHOR", &fe.max_anchor_shift);
   envd("D_MAXD", &fe.max_descriptor_distance);
   envd("D_TMAXD", &fe.max_track_descriptor_distance);
   envi("D_HALF", &fe.patch_half_size);
   const bool quiet = std::getenv("D_QUIET") != nullptr;
   DriveFigures f;
-  std::map<PointId, std::pair<Eigen::Vector3d, int>> births;
+  std::map<PointId, std::pair<std::vector<Eigen::Vector3d>, int>> births;
   runImageScenario(
       s, confidentConfig(), fe, options,
       [&](const ImageFrameResult& r, const CalibrationPipeline& pipeline) {
@@ -548,11 +602,20 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
                     r.tracks_reported, r.tracks_correct, r.tracks_checked, r.filter.tracked_points);
         for (const auto& o : pipeline.frontEnd().lastTracked()) {
           auto it = births.find(o.id);
-          if (it == births.end()) continue;
+          if (it == births.end() || it->second.first.empty()) continue;
+          // The birth candidate nearest the pair now.
           Eigen::Vector2d pl, pr;
-          const bool vl = renderer.projectVisible(*c.left, c.Tl, it->second.first, &pl);
-          const bool vr = renderer.projectVisible(*c.right, c.Tr, it->second.first, &pr);
-          const double el = (pl - o.left_pixel).norm(), er = (pr - o.right_pixel).norm();
+          bool vl = false, vr = false;
+          double el = 1e9, er = 1e9;
+          for (const Eigen::Vector3d& p : it->second.first) {
+            Eigen::Vector2d ql, qr;
+            const bool wl = renderer.projectVisible(*c.left, c.Tl, p, &ql);
+            const bool wr = renderer.projectVisible(*c.right, c.Tr, p, &qr);
+            const double dl = (ql - o.left_pixel).norm(), dr = (qr - o.right_pixel).norm();
+            if (std::max(dl, dr) < std::max(el, er)) {
+              pl = ql, pr = qr, vl = wl, vr = wr, el = dl, er = dr;
+            }
+          }
           if (!(vl && vr && el <= 1.5 && er <= 1.5) && !quiet)
             std::printf(
                 "B id %lu age %d vis %d%d L(%.0f,%.0f) errL %.2f (%.2f,%.2f) errR %.2f depth %.1f "
@@ -564,8 +627,9 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
         }
         for (const auto& o : pipeline.frontEnd().lastNewCandidates()) {
           if (!pipeline.estimator().filter().hasPoint(o.id)) continue;
-          const auto p = renderer.surfacePoint(*c.left, c.Tl, o.left_pixel);
-          if (p) births[o.id] = {*p, r.filter.frame};
+          births[o.id] = {scenePointsOfStereoMatch(renderer, *c.left, *c.right, c.Tl, c.Tr,
+                                                   o.left_pixel, o.right_pixel, 1.5),
+                          r.filter.frame};
         }
         if (std::getenv("D_IMG") && r.filter.frame == 5)
           cv::imwrite(std::getenv("D_IMG"), pipeline.debugImage());

@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "online_stereo_calibration/core/geometry/pose.h"
+#include "online_stereo_calibration/core/sim/image_scenario_runner.h"
 #include "online_stereo_calibration/core/sim/stereo_scene_renderer.h"
 
 namespace osc {
@@ -430,6 +431,46 @@ TEST(StereoSceneRenderer, StereoPatchesAgreeAtTrueCorrespondences) {
   EXPECT_GT(median(correct), 0.9);
   EXPECT_GT(good, 0.85);
   EXPECT_LT(median(shifted), 0.4);
+}
+
+TEST(StereoMatchTruth, ExactPairsPairsWithinTheToleranceAndWrongPairs) {
+  const StereoSceneRenderer& r = defaultRenderer();
+  const CameraModel camera = pinhole();
+  const Eigen::Isometry3d left = cameraPose(r.scene(), 0.0, 0.0, 0.2);
+  const Eigen::Isometry3d right = rightOf(left);
+  const double tolerance = 1.5;
+  int checked = 0;
+  for (const Eigen::Vector2d& l :
+       {Eigen::Vector2d(320, 400), Eigen::Vector2d(200, 350), Eigen::Vector2d(450, 300)}) {
+    const std::optional<Eigen::Vector3d> p = r.surfacePoint(camera, left, l);
+    Eigen::Vector2d q;
+    if (!p || !r.projectVisible(camera, right, *p, &q)) continue;
+    ++checked;
+    // The true pair: the exact surface point.
+    const StereoMatchTruth exact =
+        checkStereoMatch(r, camera, camera, left, right, l, q, tolerance);
+    EXPECT_TRUE(exact.at_pixel);
+    ASSERT_TRUE(exact.point.has_value());
+    EXPECT_LT((*exact.point - *p).norm(), 1e-6);
+    // Both pixels 1.2 px off, in opposite directions: the surface at the left pixel projects
+    // ~2.4 px from the right one, but p is within 1.2 px of both: correct, not at the pixel.
+    const Eigen::Vector2d off(1.2, 0.0);
+    const StereoMatchTruth near =
+        checkStereoMatch(r, camera, camera, left, right, l + off, q - off, tolerance);
+    EXPECT_FALSE(near.at_pixel);
+    EXPECT_TRUE(near.point.has_value());
+    EXPECT_FALSE(
+        scenePointsOfStereoMatch(r, camera, camera, left, right, l + off, q - off, tolerance)
+            .empty());
+    // 2.5 px off each way: no scene point explains the pair.
+    const Eigen::Vector2d far(2.5, 0.0);
+    EXPECT_FALSE(
+        checkStereoMatch(r, camera, camera, left, right, l + far, q - far, tolerance).point);
+    EXPECT_TRUE(
+        scenePointsOfStereoMatch(r, camera, camera, left, right, l + far, q - far, tolerance)
+            .empty());
+  }
+  EXPECT_GE(checked, 2);
 }
 
 TEST(StereoSceneRenderer, TexturesAreRichInCorners) {

@@ -924,6 +924,7 @@ TEST(FrontEndParameterTable, CoversEveryFieldOnce) {
                                            "patch_half_size",
                                            "max_refinement_shift",
                                            "max_temporal_shift",
+                                           "max_anchor_shift",
                                            "min_patch_ncc",
                                            "search_lost_tracks",
                                            "min_search_ncc",

@@ -77,14 +77,14 @@ std::vector<int> range(int first, int count) {
 /// A point's linearised measurement (regression of the UT on [x_camr, p]).
 struct CalibrationFilter::PointInnovation {
   size_t point = 0;
-  Eigen::Vector4d predicted;   ///< predicted measurement z_hat
+  Eigen::Vector4d predicted;  ///< predicted measurement z_hat
   Eigen::Vector4d residual;
-  Eigen::Matrix4d S;           ///< full innovation covariance J P J^T + S0
-  MatrixXd J;             ///< 4 x G: d residual / d global error (through x_camr and B)
+  Eigen::Matrix4d S;                ///< full innovation covariance J P J^T + S0
+  MatrixXd J;                       ///< 4 x G: d residual / d global error (through x_camr and B)
   Eigen::Matrix<double, 4, 3> H_p;  ///< d z / d point
-  Eigen::Matrix4d S0;     ///< covariance of the residual given the global error
-  double nis = 0.0;       ///< full normalised innovation squared
-  double nis_left = 0.0;  ///< left image only
+  Eigen::Matrix4d S0;               ///< covariance of the residual given the global error
+  double nis = 0.0;                 ///< full normalised innovation squared
+  double nis_left = 0.0;            ///< left image only
 };
 
 CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoIntrinsics& intrinsics)
@@ -97,7 +97,8 @@ CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoInt
   }
   if (!intrinsics.K_left.allFinite() || !intrinsics.K_right.allFinite() ||
       !(intrinsics.K_left(0, 0) > 0) || !(intrinsics.K_right(0, 0) > 0)) {
-    throw std::invalid_argument("camera matrices K_left/K_right must be finite with positive focal length");
+    throw std::invalid_argument(
+        "camera matrices K_left/K_right must be finite with positive focal length");
   }
   ut_.alpha = config.ut_alpha;
   ut_.beta = config.ut_beta;
@@ -105,13 +106,17 @@ CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoInt
   reset(StereoExtrinsics());
 }
 
-void CalibrationFilter::reset(const StereoExtrinsics& guess) { reset(guess, initialCovariance(config_)); }
+void CalibrationFilter::reset(const StereoExtrinsics& guess) {
+  reset(guess, initialCovariance(config_));
+}
 
 void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& covariance) {
-  if (!covariance.allFinite() || (covariance - covariance.transpose()).cwiseAbs().maxCoeff() >
-                                     1e-9 * covariance.cwiseAbs().maxCoeff() ||
+  if (!covariance.allFinite() ||
+      (covariance - covariance.transpose()).cwiseAbs().maxCoeff() >
+          1e-9 * covariance.cwiseAbs().maxCoeff() ||
       covariance.llt().info() != Eigen::Success) {
-    throw std::invalid_argument("initial calibration covariance must be finite, symmetric and positive definite");
+    throw std::invalid_argument(
+        "initial calibration covariance must be finite, symmetric and positive definite");
   }
   extrinsics_ = guess;
   covariance_ = covariance;
@@ -126,7 +131,8 @@ std::string CalibrationFilter::checkMotion(const MotionIncrement& m) const {
   if (!std::isfinite(m.dt) || !(m.dt > 0.0)) {
     why << "motion dt = " << m.dt << " s is not a positive number";
   } else if (m.dt > config_.max_frame_interval) {
-    why << "motion dt = " << m.dt << " s exceeds max_frame_interval_s = " << config_.max_frame_interval;
+    why << "motion dt = " << m.dt
+        << " s exceeds max_frame_interval_s = " << config_.max_frame_interval;
   } else if (!m.T_prev_curr.matrix().allFinite()) {
     why << "motion increment contains NaN or Inf";
   } else if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
@@ -165,9 +171,10 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
     selected.insert(selected.end(), motion_block.begin(), motion_block.end());
   }
   const int s = static_cast<int>(selected.size());
-  const double sigma_p2 = config_.point_position_noise * config_.point_position_noise *
-                          noiseScale(config_, motion.dt);
-  const double sigma_imu = config_.motion_rotation_noise * std::sqrt(noiseScale(config_, motion.dt));
+  const double sigma_p2 =
+      config_.point_position_noise * config_.point_position_noise * noiseScale(config_, motion.dt);
+  const double sigma_imu =
+      config_.motion_rotation_noise * std::sqrt(noiseScale(config_, motion.dt));
   const Eigen::Matrix3d R_excited = excitation_.excitedRotation(motion.T_prev_curr.linear());
 
   for (size_t i = 0; i < points_.size(); ++i) {
@@ -191,7 +198,10 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
     MatrixXd B = F_p * point.B;
     for (int a = 0; a < s; ++a) B.col(selected[a]) += ut.jacobian.col(a);
     Eigen::Matrix3d Q = sigma_p2 * Eigen::Matrix3d::Identity();
-    if (!shared) Q = paperPointProcessNoise(mean, sigma_imu, config_.point_position_noise * std::sqrt(noiseScale(config_, motion.dt)));
+    if (!shared)
+      Q = paperPointProcessNoise(
+          mean, sigma_imu,
+          config_.point_position_noise * std::sqrt(noiseScale(config_, motion.dt)));
     point.D = F_p * point.D * F_p.transpose() + ut.residual + Q;
     point.D = 0.5 * (point.D + point.D.transpose());
     point.B = B;
@@ -388,7 +398,8 @@ bool CalibrationFilter::linearizeMeasurement(size_t i, const MatrixXd& P, const 
     const Eigen::Isometry3d T_ropt_lopt =
         leftToRightOptical(boxPlus(extrinsics_.T_caml_camr, x.head<6>())).inverse();
     Eigen::Vector4d projected;
-    if (!projectStereo(point.mean + x.tail<3>(), T_ropt_lopt, intrinsics_, 1e-3, &projected)) return false;
+    if (!projectStereo(point.mean + x.tail<3>(), T_ropt_lopt, intrinsics_, 1e-3, &projected))
+      return false;
     *y = projected;
     return true;
   };
@@ -408,8 +419,8 @@ bool CalibrationFilter::linearizeMeasurement(size_t i, const MatrixXd& P, const 
   inn->S = inn->J * P * inn->J.transpose() + inn->S0;
   if (z.allFinite()) {
     inn->nis = inn->residual.dot(inn->S.llt().solve(inn->residual));
-    inn->nis_left =
-        inn->residual.head<2>().dot(inn->S.topLeftCorner<2, 2>().llt().solve(inn->residual.head<2>()));
+    inn->nis_left = inn->residual.head<2>().dot(
+        inn->S.topLeftCorner<2, 2>().llt().solve(inn->residual.head<2>()));
   }
   return true;
 }
@@ -432,6 +443,9 @@ std::vector<PredictedObservation> CalibrationFilter::predictObservations(
     prediction.id = scratch.points_[i].id;
     prediction.z = inn.predicted;
     prediction.S = inn.S;
+    const double depth_before = points_[i].mean.z(), depth_after = scratch.points_[i].mean.z();
+    if (depth_before > 0.0 && depth_after > 0.0)
+      prediction.depth_ratio = depth_before / depth_after;
     predictions.push_back(prediction);
   }
   return predictions;
@@ -460,8 +474,10 @@ bool CalibrationFilter::canReopen(JumpBlock block) const {
   // are the ordinary transient, not a sudden change.
   const int first = block == JumpBlock::kVehicleToLeft ? layout::kCaml : layout::kCamr;
   const Vector6d variance = covariance_.diagonal().segment<6>(first);
-  return variance.segment<3>(layout::kRotation).maxCoeff() < std::pow(config_.jump_rotation_sigma, 2) &&
-         variance.segment<3>(layout::kTranslation).maxCoeff() < std::pow(config_.jump_translation_sigma, 2);
+  return variance.segment<3>(layout::kRotation).maxCoeff() <
+             std::pow(config_.jump_rotation_sigma, 2) &&
+         variance.segment<3>(layout::kTranslation).maxCoeff() <
+             std::pow(config_.jump_translation_sigma, 2);
 }
 
 void CalibrationFilter::reopenBlock(JumpBlock block) {
@@ -513,7 +529,8 @@ void CalibrationFilter::rebuildIndex() {
 }
 
 bool CalibrationFilter::addPoint(const PointMeasurement& m) {
-  if (hasPoint(m.id) || !m.z.allFinite() || !m.variance.allFinite() || !(m.variance.minCoeff() > 0.0)) {
+  if (hasPoint(m.id) || !m.z.allFinite() || !m.variance.allFinite() ||
+      !(m.variance.minCoeff() > 0.0)) {
     return false;
   }
   // Scaled UT over [x_camr (6), left pixel noise (2), right pixel noise (2)] (Sec. II-A).
@@ -522,7 +539,8 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
   C.bottomRightCorner<4, 4>() = m.variance.asDiagonal();
   const double min_depth = config_.min_point_depth, max_depth = config_.max_point_depth;
   const VectorFunction triangulate = [&](const VectorXd& x, VectorXd* y) {
-    const Eigen::Isometry3d T_lopt_ropt = leftToRightOptical(boxPlus(extrinsics_.T_caml_camr, x.head<6>()));
+    const Eigen::Isometry3d T_lopt_ropt =
+        leftToRightOptical(boxPlus(extrinsics_.T_caml_camr, x.head<6>()));
     const auto p = triangulateStereo(m.z + x.tail<4>(), T_lopt_ropt, intrinsics_);
     if (!p || p->z() < 0.5 * min_depth || p->z() > 2.0 * max_depth) return false;
     *y = *p;

@@ -221,6 +221,10 @@ const std::vector<FrontEndParameterSpec>& frontEndParameterTable() {
            "largest move (px) of the stereo alignment from the matched right keypoint"),
       real("max_temporal_shift", &C::max_temporal_shift, 0.0, 20.0, kOpen,
            "largest move (px) of a track's alignment from the keypoint found"),
+      real("max_anchor_shift", &C::max_anchor_shift, 0.0, 20.0, kClosed,
+           "tracks: largest move (px) of the alignment of the point's first patch, resampled by "
+           "its predicted growth, from the frame-to-frame position; beyond, or below "
+           "min_patch_ncc, the track has slid off its point and is dropped (0 = off)"),
       real("min_patch_ncc", &C::min_patch_ncc, -1.0, 1.0, kClosed,
            "least normalised cross-correlation of the aligned patches"),
       boolean("search_lost_tracks", &C::search_lost_tracks,

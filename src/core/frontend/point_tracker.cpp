@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <Eigen/LU>
 
@@ -50,7 +51,7 @@ PointTracker::PointTracker(const FrontEndConfig& config) : config_(config) {}
 
 void PointTracker::add(PointId id, const cv::Mat& left_descriptor, const cv::Mat& right_descriptor,
                        const Eigen::Vector2d& left_pixel) {
-  tracks_[id] = Track{left_descriptor.clone(), right_descriptor.clone(), left_pixel};
+  tracks_[id] = Track{left_descriptor.clone(), right_descriptor.clone(), left_pixel, TrackAnchor()};
 }
 
 bool PointTracker::leftPixel(PointId id, Eigen::Vector2d* pixel) const {
@@ -63,6 +64,22 @@ bool PointTracker::leftPixel(PointId id, Eigen::Vector2d* pixel) const {
 void PointTracker::setLeftPixel(PointId id, const Eigen::Vector2d& pixel) {
   const auto it = tracks_.find(id);
   if (it != tracks_.end()) it->second.left_pixel = pixel;
+}
+
+void PointTracker::setAnchor(PointId id, TrackAnchor anchor) {
+  const auto it = tracks_.find(id);
+  if (it != tracks_.end()) it->second.anchor = std::move(anchor);
+}
+
+const TrackAnchor* PointTracker::anchor(PointId id) const {
+  const auto it = tracks_.find(id);
+  if (it == tracks_.end() || it->second.anchor.crop.empty()) return nullptr;
+  return &it->second.anchor;
+}
+
+void PointTracker::growAnchor(PointId id, double factor) {
+  const auto it = tracks_.find(id);
+  if (it != tracks_.end()) it->second.anchor.scale *= factor;
 }
 
 void PointTracker::remove(PointId id) { tracks_.erase(id); }
@@ -78,6 +95,7 @@ std::vector<TrackWindow> PointTracker::windows(const std::vector<PredictedObserv
     w.id = p.id;
     w.z = p.z;
     w.S = p.S;
+    w.scale = p.depth_ratio;
     window(left, p.z.head<2>(), p.S.topLeftCorner<2, 2>(), config_, &w.left_center, &w.left_half);
     window(right, p.z.tail<2>(), p.S.bottomRightCorner<2, 2>(), config_, &w.right_center,
            &w.right_half);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_map>
 #include <unordered_set>
 
 #include <Eigen/LU>
@@ -32,6 +33,27 @@ StereoObservation observation(PointId id, const Eigen::Vector2d& left,
   o.left_pixel = left;
   o.right_pixel = right;
   return o;
+}
+
+/// The template scale of a track's temporal alignment: the predicted growth of its patch,
+/// bounded so that a badly estimated point cannot ask for an absurd resampling.
+double templateScale(const TrackWindow& w) {
+  return std::isfinite(w.scale) ? std::clamp(w.scale, 0.5, 2.0) : 1.0;
+}
+
+/// The anchor of a new point: a crop of its left image around the pixel, wide enough for its
+/// patch resampled at half the size (radius 2 (half_size + 1) + 1), clipped at the border.
+TrackAnchor makeAnchor(const cv::Mat& image, const Eigen::Vector2d& pixel, int half_size) {
+  const int radius = 2 * (half_size + 1) + 1;
+  const cv::Rect wanted(static_cast<int>(std::lround(pixel.x())) - radius,
+                        static_cast<int>(std::lround(pixel.y())) - radius, 2 * radius + 1,
+                        2 * radius + 1);
+  const cv::Rect inside = wanted & cv::Rect(0, 0, image.cols, image.rows);
+  TrackAnchor anchor;
+  if (inside.area() == 0) return anchor;
+  anchor.crop = image(inside).clone();
+  anchor.pixel = pixel - Eigen::Vector2d(inside.x, inside.y);
+  return anchor;
 }
 
 }  // namespace
@@ -121,6 +143,35 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
                                       config_.patch_half_size, config_.discontinuity_search));
   };
 
+  // A track's left pixel checked against its anchor (the point's first patch, resampled by
+  // its predicted growth since): moved to where the anchor aligns, or false if the anchor no
+  // longer aligns near it (the track slid off its point).
+  auto anchored = [&](PointId id, Eigen::Vector2d* left_raw) {
+    const TrackAnchor* anchor = tracker_.anchor(id);
+    if (config_.max_anchor_shift <= 0.0 || anchor == nullptr) return true;
+    PatchAlignmentConfig c = alignment;
+    c.max_shift = config_.max_anchor_shift;
+    c.template_scale = std::clamp(anchor->scale, 0.5, 2.0);
+    const PatchAlignment a = alignPatch(anchor->crop, anchor->pixel, left_mono, *left_raw, c);
+    if (!a.ok) return false;
+    *left_raw = a.position;
+    return true;
+  };
+
+  // The anchor is only resampled in scale; a surface seen obliquely (the ground) also shears
+  // and foreshortens as it nears, so once its patch has grown or shrunk by more than
+  // kMaxAnchorGrowth the anchor is taken anew from this image (a small, rare restart of drift
+  // instead of a biased alignment).
+  auto reanchorIfDeformed = [&](PointId id, const Eigen::Vector2d& left_raw) {
+    constexpr double kMaxAnchorGrowth = 1.25;
+    const TrackAnchor* anchor = tracker_.anchor(id);
+    if (anchor == nullptr ||
+        (anchor->scale <= kMaxAnchorGrowth && anchor->scale >= 1.0 / kMaxAnchorGrowth)) {
+      return;
+    }
+    tracker_.setAnchor(id, makeAnchor(left_mono, left_raw, config_.patch_half_size));
+  };
+
   // 1. Tracking (Sec. II-C): windows from the filter's predictions and S.
   std::vector<StereoObservation> observations;
   if (tracker_.size() > 0 && filter.pointCount() > 0) {
@@ -134,17 +185,29 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     // the detector's pixel-grid jitter), then into the right image.
     PatchAlignmentConfig temporal = alignment;
     temporal.max_shift = config_.max_temporal_shift;
+    std::unordered_map<PointId, double> scale_of;
+    for (const TrackWindow& w : last_windows_) {
+      scale_of[w.id] = templateScale(w);
+      tracker_.growAnchor(w.id, templateScale(w));
+    }
+    const auto scaleOf = [&](PointId id) {
+      const auto it = scale_of.find(id);
+      return it == scale_of.end() ? 1.0 : it->second;
+    };
     for (const TrackMatch& m : found) {
       Eigen::Vector2d left_raw = left.raw[static_cast<size_t>(m.left)];
       Eigen::Vector2d left_und = left.undistorted[static_cast<size_t>(m.left)];
       Eigen::Vector2d previous;
       if (!previous_left_.empty() && tracker_.leftPixel(m.id, &previous)) {
+        temporal.template_scale = scaleOf(m.id);
         const PatchAlignment a =
             alignPatch(previous_left_, previous, left_mono, left_raw, temporal);
         if (!a.ok) continue;
         left_raw = a.position;
         left_und = left_camera_.undistortPixel(left_raw);
       }
+      if (!anchored(m.id, &left_raw)) continue;
+      left_und = left_camera_.undistortPixel(left_raw);
       Eigen::Vector2d right_raw, right_und;
       if (!refine(left_raw, left_und, right.raw[static_cast<size_t>(m.right)], &right_raw,
                   &right_und) ||
@@ -152,6 +215,7 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
         continue;
       }
       tracker_.setLeftPixel(m.id, left_raw);
+      reanchorIfDeformed(m.id, left_raw);
       observations.push_back(observation(m.id, left_raw, right_raw));
     }
   }
@@ -169,14 +233,18 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
       PatchAlignmentConfig search = alignment;
       search.max_shift = w.left_half.maxCoeff();
       search.min_ncc = config_.min_search_ncc;
+      search.template_scale = templateScale(w);
       const PatchAlignment a =
           alignPatch(previous_left_, previous, left_mono, w.left_center, search);
       if (!a.ok) continue;
       // Forward-backward: the found patch aligned back must land where the point was.
+      PatchAlignmentConfig backward = search;
+      backward.template_scale = 1.0 / search.template_scale;
       const PatchAlignment back =
-          alignPatch(left_mono, a.position, previous_left_, previous, search);
+          alignPatch(left_mono, a.position, previous_left_, previous, backward);
       if (!back.ok || (back.position - previous).norm() > config_.max_forward_backward) continue;
-      const Eigen::Vector2d left_raw = a.position;
+      Eigen::Vector2d left_raw = a.position;
+      if (!anchored(w.id, &left_raw)) continue;
       const Eigen::Vector2d left_und = left_camera_.undistortPixel(left_raw);
       const Eigen::Vector2d el = left_und - w.z.head<2>();
       const Eigen::Matrix2d S_ll = w.S.topLeftCorner<2, 2>();
@@ -202,6 +270,7 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
         continue;
       }
       tracker_.setLeftPixel(w.id, left_raw);
+      reanchorIfDeformed(w.id, left_raw);
       observations.push_back(observation(w.id, left_raw, right_raw));
     }
   }
@@ -299,8 +368,12 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     last_bands_.push_back(
         bandPolylines(left.undistorted[static_cast<size_t>(m.left)],
                       right_camera_.undistortPixel(right_positions[static_cast<size_t>(u)])));
-    pending_.push_back({id, left.descriptors.row(m.left).clone(),
-                        right.descriptors.row(m.right).clone(), positions[static_cast<size_t>(u)]});
+    pending_.push_back(
+        {id, left.descriptors.row(m.left).clone(), right.descriptors.row(m.right).clone(),
+         positions[static_cast<size_t>(u)],
+         config_.max_anchor_shift > 0.0
+             ? makeAnchor(left_mono, positions[static_cast<size_t>(u)], config_.patch_half_size)
+             : TrackAnchor()});
   }
   stats.new_candidates = static_cast<int>(last_new_.size());
   if (statistics) *statistics = stats;
@@ -369,6 +442,7 @@ void StereoFrontEnd::commit(const FrameReport& report, const CalibrationFilter& 
   for (const Pending& p : pending_) {
     if (filter.hasPoint(p.id)) {
       tracker_.add(p.id, p.left_descriptor, p.right_descriptor, p.left_pixel);
+      tracker_.setAnchor(p.id, p.anchor);
     }
   }
   pending_.clear();

@@ -1,5 +1,6 @@
 #include "online_stereo_calibration/core/sim/image_scenario_runner.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -15,15 +16,78 @@
 
 namespace osc {
 
-bool isCorrectStereoMatch(const StereoSceneRenderer& renderer, const CameraModel& left,
+namespace {
+
+/// Squared distance of p's true pixels to the pair (seen_at: where p is seen in the left
+/// image) if p's right pixel is visible and within tolerance, else -1.
+double pairError(const StereoSceneRenderer& renderer, const CameraModel& right,
+                 const Eigen::Isometry3d& T_world_ropt, const Eigen::Vector3d& p,
+                 const Eigen::Vector2d& seen_at, const Eigen::Vector2d& left_pixel,
+                 const Eigen::Vector2d& right_pixel, double tolerance) {
+  Eigen::Vector2d projected;
+  if (!renderer.projectVisible(right, T_world_ropt, p, &projected)) return -1.0;
+  const double right_error = (projected - right_pixel).norm();
+  if (right_error > tolerance) return -1.0;
+  return right_error * right_error + (seen_at - left_pixel).squaredNorm();
+}
+
+/// Calls visit(point, error) for every surface point seen within `tolerance` of left_pixel
+/// (sampled every 0.25 px) that explains the pair (pairError >= 0).
+template <typename Visit>
+void forEachPointNearPair(const StereoSceneRenderer& renderer, const CameraModel& left,
                           const CameraModel& right, const Eigen::Isometry3d& T_world_lopt,
                           const Eigen::Isometry3d& T_world_ropt, const Eigen::Vector2d& left_pixel,
-                          const Eigen::Vector2d& right_pixel, double tolerance) {
-  const std::optional<Eigen::Vector3d> p = renderer.surfacePoint(left, T_world_lopt, left_pixel);
-  if (!p) return false;
-  Eigen::Vector2d projected;
-  if (!renderer.projectVisible(right, T_world_ropt, *p, &projected)) return false;
-  return (projected - right_pixel).norm() <= tolerance;
+                          const Eigen::Vector2d& right_pixel, double tolerance, Visit visit) {
+  constexpr double kStep = 0.25;  // px between the sampled rays around the left pixel
+  const int steps = static_cast<int>(std::floor(tolerance / kStep));
+  for (int dy = -steps; dy <= steps; ++dy) {
+    for (int dx = -steps; dx <= steps; ++dx) {
+      const Eigen::Vector2d seen_at = left_pixel + kStep * Eigen::Vector2d(dx, dy);
+      if ((seen_at - left_pixel).norm() > tolerance) continue;
+      const std::optional<Eigen::Vector3d> p = renderer.surfacePoint(left, T_world_lopt, seen_at);
+      if (!p) continue;
+      const double error =
+          pairError(renderer, right, T_world_ropt, *p, seen_at, left_pixel, right_pixel, tolerance);
+      if (error >= 0.0) visit(*p, error);
+    }
+  }
+}
+
+}  // namespace
+
+StereoMatchTruth checkStereoMatch(const StereoSceneRenderer& renderer, const CameraModel& left,
+                                  const CameraModel& right, const Eigen::Isometry3d& T_world_lopt,
+                                  const Eigen::Isometry3d& T_world_ropt,
+                                  const Eigen::Vector2d& left_pixel,
+                                  const Eigen::Vector2d& right_pixel, double tolerance) {
+  StereoMatchTruth truth;
+  const std::optional<Eigen::Vector3d> exact =
+      renderer.surfacePoint(left, T_world_lopt, left_pixel);
+  if (exact && pairError(renderer, right, T_world_ropt, *exact, left_pixel, left_pixel, right_pixel,
+                         tolerance) >= 0.0) {
+    truth.at_pixel = true;
+    truth.point = exact;
+    return truth;
+  }
+  double best = -1.0;
+  forEachPointNearPair(renderer, left, right, T_world_lopt, T_world_ropt, left_pixel, right_pixel,
+                       tolerance, [&](const Eigen::Vector3d& p, double error) {
+                         if (best < 0.0 || error < best) {
+                           best = error;
+                           truth.point = p;
+                         }
+                       });
+  return truth;
+}
+
+std::vector<Eigen::Vector3d> scenePointsOfStereoMatch(
+    const StereoSceneRenderer& renderer, const CameraModel& left, const CameraModel& right,
+    const Eigen::Isometry3d& T_world_lopt, const Eigen::Isometry3d& T_world_ropt,
+    const Eigen::Vector2d& left_pixel, const Eigen::Vector2d& right_pixel, double tolerance) {
+  std::vector<Eigen::Vector3d> points;
+  forEachPointNearPair(renderer, left, right, T_world_lopt, T_world_ropt, left_pixel, right_pixel,
+                       tolerance, [&](const Eigen::Vector3d& p, double) { points.push_back(p); });
+  return points;
 }
 
 std::vector<ImageFrameResult> runImageScenario(
@@ -51,7 +115,12 @@ std::vector<ImageFrameResult> runImageScenario(
 
   CalibrationPipeline pipeline(filter_config, front_end_config, scenario.left, scenario.right,
                                simulator.initialGuess());
-  std::unordered_map<PointId, Eigen::Vector3d> birth_points;
+  // The scene points a tracked point's birth match may show, and the one at its left pixel.
+  struct Birth {
+    std::vector<Eigen::Vector3d> points;
+    std::optional<Eigen::Vector3d> at_pixel;
+  };
+  std::unordered_map<PointId, Birth> births;
   std::vector<ImageFrameResult> results;
   results.reserve(static_cast<size_t>(scenario.frames));
   SimulatedFrame frame;
@@ -81,37 +150,50 @@ std::vector<ImageFrameResult> runImageScenario(
     // Correctness against the renderer's ground truth.
     const StereoFrontEnd& front_end = pipeline.frontEnd();
     const double tol = options.correct_tolerance;
+    const auto check = [&](const StereoObservation& o) {
+      return checkStereoMatch(renderer, left_camera, right_camera, T_world_lopt, T_world_ropt,
+                              o.left_pixel, o.right_pixel, tol);
+    };
     if (options.check_all_matches) {
       for (const StereoObservation& o : front_end.lastStereoMatches()) {
+        const StereoMatchTruth truth = check(o);
         ++r.matches_checked;
-        r.matches_correct += isCorrectStereoMatch(renderer, left_camera, right_camera, T_world_lopt,
-                                                  T_world_ropt, o.left_pixel, o.right_pixel, tol);
+        r.matches_correct += truth.point.has_value();
+        r.matches_correct_at_pixel += truth.at_pixel;
       }
     }
     for (const StereoObservation& o : front_end.lastNewCandidates()) {
+      const StereoMatchTruth truth = check(o);
       ++r.new_checked;
-      r.new_correct += isCorrectStereoMatch(renderer, left_camera, right_camera, T_world_lopt,
-                                            T_world_ropt, o.left_pixel, o.right_pixel, tol);
+      r.new_correct += truth.point.has_value();
+      r.new_correct_at_pixel += truth.at_pixel;
+      // A wrong birth match has no scene point; its track is counted as wrong throughout.
       if (pipeline.estimator().filter().hasPoint(o.id)) {
-        const auto p = renderer.surfacePoint(left_camera, T_world_lopt, o.left_pixel);
-        if (p) birth_points[o.id] = *p;
+        Birth& birth = births[o.id];
+        birth.points = scenePointsOfStereoMatch(renderer, left_camera, right_camera, T_world_lopt,
+                                                T_world_ropt, o.left_pixel, o.right_pixel, tol);
+        birth.at_pixel = renderer.surfacePoint(left_camera, T_world_lopt, o.left_pixel);
       }
     }
     for (const StereoObservation& o : front_end.lastTracked()) {
+      const StereoMatchTruth truth = check(o);
       ++r.tracks_reported;
-      r.tracks_stereo_correct +=
-          isCorrectStereoMatch(renderer, left_camera, right_camera, T_world_lopt, T_world_ropt,
-                               o.left_pixel, o.right_pixel, tol);
-      const auto it = birth_points.find(o.id);
-      if (it == birth_points.end()) continue;
+      r.tracks_stereo_correct += truth.point.has_value();
+      r.tracks_stereo_correct_at_pixel += truth.at_pixel;
+      const auto it = births.find(o.id);
+      if (it == births.end()) continue;
       ++r.tracks_checked;
-      Eigen::Vector2d pl, pr;
-      const bool ok = renderer.projectVisible(left_camera, T_world_lopt, it->second, &pl) &&
-                      renderer.projectVisible(right_camera, T_world_ropt, it->second, &pr) &&
-                      (pl - o.left_pixel).norm() <= tol && (pr - o.right_pixel).norm() <= tol;
-      r.tracks_correct += ok;
+      const auto stillOn = [&](const Eigen::Vector3d& p) {
+        Eigen::Vector2d pl, pr;
+        return renderer.projectVisible(left_camera, T_world_lopt, p, &pl) &&
+               renderer.projectVisible(right_camera, T_world_ropt, p, &pr) &&
+               (pl - o.left_pixel).norm() <= tol && (pr - o.right_pixel).norm() <= tol;
+      };
+      const Birth& birth = it->second;
+      r.tracks_correct += std::any_of(birth.points.begin(), birth.points.end(), stillOn);
+      r.tracks_correct_at_birth_pixel += birth.at_pixel && stillOn(*birth.at_pixel);
     }
-    for (PointId id : result.estimator.dropped) birth_points.erase(id);
+    for (PointId id : result.estimator.dropped) births.erase(id);
 
     r.filter =
         makeFrameResult(frame, result.estimate, result.estimator, 1e3 * result.processing_time);

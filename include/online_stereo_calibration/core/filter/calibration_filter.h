@@ -31,7 +31,7 @@ namespace osc {
 /// One stereo measurement of a tracked point in undistorted pixels (measurement_model.h).
 struct PointMeasurement {
   PointId id = 0;
-  Eigen::Vector4d z = Eigen::Vector4d::Zero();  ///< [u_l, v_l, u_r, v_r]
+  Eigen::Vector4d z = Eigen::Vector4d::Zero();         ///< [u_l, v_l, u_r, v_r]
   Eigen::Vector4d variance = Eigen::Vector4d::Ones();  ///< px^2 per coordinate
 };
 
@@ -46,7 +46,11 @@ struct PointEstimate {
 struct PredictedObservation {
   PointId id = 0;
   Eigen::Vector4d z = Eigen::Vector4d::Zero();  ///< predicted [u_l, v_l, u_r, v_r], undistorted px
-  Eigen::Matrix4d S = Eigen::Matrix4d::Identity();  ///< innovation covariance (px^2), incl. pixel noise
+  Eigen::Matrix4d S =
+      Eigen::Matrix4d::Identity();  ///< innovation covariance (px^2), incl. pixel noise
+  /// The point's depth in the left camera before the motion over its predicted depth after
+  /// it: how much larger its surface appears in the new image (> 1 when approaching).
+  double depth_ratio = 1.0;
 };
 
 /// Which calibration block a detected sudden change was attributed to.
@@ -54,15 +58,15 @@ enum class JumpBlock { kNone, kVehicleToLeft, kLeftToRight };
 
 /// What one filter step did.
 struct StepReport {
-  bool accepted = false;        ///< false: the input was rejected and nothing changed
-  std::string message;          ///< why it was rejected, or notes
-  int measurements_used = 0;    ///< points that updated the filter
-  int invalid_measurements = 0; ///< non-finite or non-positive-variance measurements ignored
-  std::vector<PointId> outliers;  ///< gated out (Mahalanobis) and removed
-  std::vector<PointId> lost;      ///< not measured (or unpredictable) and removed
+  bool accepted = false;              ///< false: the input was rejected and nothing changed
+  std::string message;                ///< why it was rejected, or notes
+  int measurements_used = 0;          ///< points that updated the filter
+  int invalid_measurements = 0;       ///< non-finite or non-positive-variance measurements ignored
+  std::vector<PointId> outliers;      ///< gated out (Mahalanobis) and removed
+  std::vector<PointId> lost;          ///< not measured (or unpredictable) and removed
   JumpBlock jump = JumpBlock::kNone;  ///< a sudden calibration change was detected
   bool covariance_repaired = false;   ///< the calibration covariance had to be made PD
-  double mean_nis = 0.0;        ///< mean normalised innovation squared of used points (4 dof)
+  double mean_nis = 0.0;              ///< mean normalised innovation squared of used points (4 dof)
 };
 
 /// Structured UKF for the stereo extrinsics and the tracked points.

@@ -57,6 +57,9 @@ struct FrontEndConfig {
   /// Tracks: the point's patch in the previous left image is aligned into the current one
   /// from the keypoint found; largest move (px) from that keypoint, (0, 20].
   double max_temporal_shift = 3.0;
+  /// Tracks: largest move (px) of the alignment of the point's first patch (resampled by its
+  /// predicted growth) from the frame-to-frame position; fails = the track slid off (0 = off).
+  double max_anchor_shift = 1.0;
   /// Least normalised cross-correlation of the aligned patches, [-1, 1]: below, the two
   /// views show different things there (an occluding edge, a wrong match).
   double min_patch_ncc = 0.9;

@@ -18,6 +18,10 @@ struct PatchAlignmentConfig {
   double max_shift = 2.0;        ///< largest move from the initial guess
   double min_ncc = 0.9;          ///< least normalised cross-correlation after alignment
   double min_eigenvalue = 0.05;  ///< least smaller/larger eigenvalue ratio of the structure tensor
+  /// How much larger `target` shows the surface than `source` (the template is resampled
+  /// from the source at 1/scale px spacing, so an approaching point does not make the
+  /// translation-only alignment drift; 1 = same size). Must be > 0.
+  double template_scale = 1.0;
 };
 
 /// Result of alignPatch.

@@ -29,6 +29,18 @@ struct TrackWindow {
   /// The prediction: [u_l, v_l, u_r, v_r] (undistorted px) and its innovation covariance.
   Eigen::Vector4d z = Eigen::Vector4d::Zero();
   Eigen::Matrix4d S = Eigen::Matrix4d::Identity();
+  /// How much larger the point's patch appears in this left image than in the previous one
+  /// (PredictedObservation::depth_ratio).
+  double scale = 1.0;
+};
+
+/// A tracked point's patch from the left image it was first seen in: the reference that
+/// keeps its track on the same surface point (frame-to-frame alignment alone drifts, and
+/// follows an outline sliding over the background).
+struct TrackAnchor {
+  cv::Mat crop;                                     ///< mono8 crop of that left image
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  ///< the point's pixel in the crop
+  double scale = 1.0;  ///< predicted growth of the point's patch since then
 };
 
 /// A tracked point found again in both images (indices into the FeatureSets).
@@ -50,6 +62,12 @@ class PointTracker {
   bool leftPixel(PointId id, Eigen::Vector2d* pixel) const;
   /// Records where the point was seen in the left image of this pair.
   void setLeftPixel(PointId id, const Eigen::Vector2d& pixel);
+  /// Keeps `anchor` as the point's first patch (no-op for an unknown id).
+  void setAnchor(PointId id, TrackAnchor anchor);
+  /// The point's anchor, or nullptr if it has none.
+  const TrackAnchor* anchor(PointId id) const;
+  /// Multiplies the anchor's scale by this frame's predicted growth of the patch.
+  void growAnchor(PointId id, double factor);
   void remove(PointId id);
   void clear() { tracks_.clear(); }
   bool has(PointId id) const { return tracks_.count(id) > 0; }
@@ -81,6 +99,7 @@ class PointTracker {
     cv::Mat left_descriptor;
     cv::Mat right_descriptor;
     Eigen::Vector2d left_pixel = Eigen::Vector2d::Zero();
+    TrackAnchor anchor;  ///< empty crop: none
   };
   FrontEndConfig config_;
   std::unordered_map<PointId, Track> tracks_;

@@ -95,6 +95,7 @@ class StereoFrontEnd {
     PointId id;
     cv::Mat left_descriptor, right_descriptor;
     Eigen::Vector2d left_pixel;
+    TrackAnchor anchor;
   };
   std::vector<Pending> pending_;
   cv::Mat last_left_, last_right_;

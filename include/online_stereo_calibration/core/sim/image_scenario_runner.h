@@ -6,6 +6,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "online_stereo_calibration/core/config/filter_config.h"
@@ -35,32 +36,62 @@ struct ImageScenarioOptions {
   bool check_all_matches = true;
 };
 
-/// One frame of an image-level run.
+/// One frame of an image-level run. A stereo pair is correct if one visible scene point has
+/// its true pixels within the tolerance of both reported pixels (StereoMatchTruth::point);
+/// the `_at_pixel` counts use the stricter test that the surface seen exactly at the left
+/// pixel projects within tolerance of the right pixel, which also fails a correct match of an
+/// object's outline whose keypoint lies a fraction of a pixel off the object, on the sky.
 struct ImageFrameResult {
   ScenarioFrameResult filter;  ///< estimate vs truth, as in the measurement-level runner
   bool processed = false;      ///< the pipeline used the pair
   FrontEndStatistics front_end;
   int matches_checked = 0;  ///< stereo matches checked (all before bucketing)
-  int matches_correct = 0;  ///< ... of which within tolerance of the truth
-  int new_checked = 0;      ///< new candidates offered
+  int matches_correct = 0;  ///< ... of which correct
+  int matches_correct_at_pixel = 0;
+  int new_checked = 0;  ///< new candidates offered
   int new_correct = 0;
-  int tracks_reported = 0;  ///< tracked points reported to the estimator
-  /// ... whose stereo pair is correct in this frame (as for matches: the surface point at the
-  /// left pixel projects within tolerance of the right pixel)
-  int tracks_stereo_correct = 0;
-  int tracks_checked = 0;  ///< tracked points reported whose birth point is known
-  /// ... still on the point seen at their birth: within tolerance of its true projections in
-  /// both images (stricter: includes drift along the track)
+  int new_correct_at_pixel = 0;
+  int tracks_reported = 0;        ///< tracked points reported to the estimator
+  int tracks_stereo_correct = 0;  ///< ... whose stereo pair is correct in this frame
+  int tracks_stereo_correct_at_pixel = 0;
+  int tracks_checked = 0;  ///< tracked points reported whose birth match was checked
+  /// ... still on a scene point of their birth match (scenePointsOfStereoMatch; none if that
+  /// match was wrong): within tolerance of its true projections in both images (stricter:
+  /// includes drift along the track)
   int tracks_correct = 0;
+  /// ... still on the surface point seen exactly at their birth's left pixel
+  int tracks_correct_at_birth_pixel = 0;
   double render_ms = 0.0;  ///< time spent rendering this pair
 };
 
-/// True if (left_pixel, right_pixel) are the images of one surface point: the point seen at
-/// left_pixel (renderer.surfacePoint) projects visibly within `tolerance` px of right_pixel.
-bool isCorrectStereoMatch(const StereoSceneRenderer& renderer, const CameraModel& left,
-                          const CameraModel& right, const Eigen::Isometry3d& T_world_lopt,
-                          const Eigen::Isometry3d& T_world_ropt, const Eigen::Vector2d& left_pixel,
-                          const Eigen::Vector2d& right_pixel, double tolerance);
+/// What the scene says about a stereo pair (left_pixel, right_pixel).
+struct StereoMatchTruth {
+  /// The surface point seen exactly at left_pixel projects visibly within tolerance of
+  /// right_pixel.
+  bool at_pixel = false;
+  /// The visible surface point whose true pixels are nearest the pair (sum of squared
+  /// distances), among those within tolerance in both images; none if there is no such
+  /// point, i.e. the match is wrong. The exact point at left_pixel if at_pixel.
+  std::optional<Eigen::Vector3d> point;
+};
+
+/// Checks a stereo pair against the scene: first the surface point at left_pixel, and if
+/// that fails, the surface points seen within `tolerance` of left_pixel (sampled every
+/// 0.25 px), so that a keypoint on an object's outline counts as the object's point.
+StereoMatchTruth checkStereoMatch(const StereoSceneRenderer& renderer, const CameraModel& left,
+                                  const CameraModel& right, const Eigen::Isometry3d& T_world_lopt,
+                                  const Eigen::Isometry3d& T_world_ropt,
+                                  const Eigen::Vector2d& left_pixel,
+                                  const Eigen::Vector2d& right_pixel, double tolerance);
+
+/// Every scene point a stereo pair may show: the surface points seen at left_pixel and within
+/// `tolerance` of it (sampled every 0.25 px) whose true right pixel is visible and within
+/// `tolerance` of right_pixel. More than one surface where the keypoint lies on an outline
+/// (the object's edge and the background both within tolerance).
+std::vector<Eigen::Vector3d> scenePointsOfStereoMatch(
+    const StereoSceneRenderer& renderer, const CameraModel& left, const CameraModel& right,
+    const Eigen::Isometry3d& T_world_lopt, const Eigen::Isometry3d& T_world_ropt,
+    const Eigen::Vector2d& left_pixel, const Eigen::Vector2d& right_pixel, double tolerance);
 
 /// Runs the scenario (scenario.frames pairs, truth incl. its step and drift) through a
 /// CalibrationPipeline started from the scenario's initial guess. The measured motion, the
