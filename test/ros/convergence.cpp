@@ -124,8 +124,9 @@ TEST(Convergence, TfAndCalibrationConvergeToTheTruthOfARenderedDrive) {
   for (int i : {9, 10, 11}) EXPECT_LT(std::abs(error[i]), 0.02 * kDeg) << names[i];  // rad
   // Every start error at least halved.
   for (int i = 0; i < 12; ++i) {
-    if (guess[i] != truth(i))
+    if (guess[i] != truth(i)) {
       EXPECT_LT(std::abs(error[i]), 0.5 * std::abs(guess[i] - truth(i))) << names[i];
+    }
   }
   // Not overconfident: every error within 3 sigma (measured: at most 2.0 sigma, yaw_r).
   for (int i = 0; i < 12; ++i) EXPECT_LT(std::abs(error[i]), 3.0 * sigma[i]) << names[i];
