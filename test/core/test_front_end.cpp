@@ -529,8 +529,9 @@ double diagPair(const DiagCtx& c, const char* tag, const Eigen::Vector2d& pl,
 /// stereo match (M) and track (T) with its true pixel, error along/across the line, depth
 /// and depth discontinuity around the pixel (edgeL/R: largest relative depth change within
 /// 2 px; 10 = sky), every track off its birth point (B), and a SUMMARY. Environment:
-/// DIAG_FRAMES, DIAG_DISTORT, D_QUIET, D_IMG (debug image of frame 5) and D_* overrides of
-/// the FrontEndConfig.
+/// DIAG_FRAMES, DIAG_DISTORT (plumb_bob, or "equidistant"), D_QUIET, D_IMG (debug image of
+/// frame 5), D_CROP=id (x8 crops of that track's images, /tmp/crop_ID_FRAME.png), D_NOISE,
+/// D_BLUR, D_FLICKER (the image options) and D_* overrides of the FrontEndConfig.
 TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
   const int frames = std::getenv("DIAG_FRAMES") ? std::atoi(std::getenv("DIAG_FRAMES")) : 25;
   MeasurementScenario s = shortDrive(frames);
@@ -615,6 +616,39 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
             if (std::max(dl, dr) < std::max(el, er)) {
               pl = ql, pr = qr, vl = wl, vr = wr, el = dl, er = dr;
             }
+          }
+          if (std::getenv("D_CROP") && o.id == std::strtoul(std::getenv("D_CROP"), nullptr, 10)) {
+            // Crops (x8) of this track's left and right images around its pixels: the
+            // reported pixel in red, the nearest birth candidate's projection in green.
+            RenderOptions ro = options.render;
+            ro.noise_seed = 2u * static_cast<unsigned>(r.filter.frame) + 1u;
+            const cv::Mat li = renderer.render(*c.left, c.Tl, ro);
+            ro.noise_seed += 1u;
+            const cv::Mat ri = renderer.render(*c.right, c.Tr, ro);
+            auto crop = [](const cv::Mat& im, const Eigen::Vector2d& at,
+                           const Eigen::Vector2d& truth) {
+              const int R = 12, S = 8;
+              cv::Mat out;
+              cv::Mat patch;
+              cv::getRectSubPix(im, cv::Size(2 * R + 1, 2 * R + 1),
+                                cv::Point2f(std::round(at.x()), std::round(at.y())), patch);
+              cv::resize(patch, out, cv::Size(), S, S, cv::INTER_NEAREST);
+              cv::cvtColor(out, out, cv::COLOR_GRAY2BGR);
+              auto mark = [&](const Eigen::Vector2d& p, cv::Scalar col) {
+                const Eigen::Vector2d q =
+                    (p - Eigen::Vector2d(std::round(at.x()) - R, std::round(at.y()) - R)) * S +
+                    Eigen::Vector2d(S / 2, S / 2);
+                cv::circle(out, cv::Point(q.x(), q.y()), 5, col, 2);
+              };
+              mark(at, cv::Scalar(0, 0, 255));
+              mark(truth, cv::Scalar(0, 255, 0));
+              return out;
+            };
+            cv::Mat both;
+            cv::hconcat(crop(li, o.left_pixel, pl), crop(ri, o.right_pixel, pr), both);
+            cv::imwrite(
+                "/tmp/crop_" + std::to_string(o.id) + "_" + std::to_string(r.filter.frame) + ".png",
+                both);
           }
           if (!(vl && vr && el <= 1.5 && er <= 1.5) && !quiet)
             std::printf(
