@@ -31,12 +31,16 @@ class SpatialGrid {
  public:
   /// Indexes points (px) of an image of the given size with square cells.
   void build(const std::vector<Eigen::Vector2d>& points, int width, int height, double cell);
-  /// Appends to `out` the indices of points inside [min, max] (box, px).
+  /// Appends to `out` the indices of points inside [min, max] (box, px): cell by cell, row
+  /// by row, and in increasing index within a cell.
   void query(const Eigen::Vector2d& min, const Eigen::Vector2d& max, std::vector<int>* out) const;
 
  private:
-  std::vector<Eigen::Vector2d> points_;
-  std::vector<std::vector<int>> cells_;
+  // The points sorted by cell (row-major, stable): the cells of one grid row that a box
+  // covers are one contiguous range, scanned without indirection.
+  std::vector<int> cell_start_;                 ///< cols_ * rows_ + 1 offsets into the two below
+  std::vector<int> sorted_index_;               ///< point index, in cell order
+  std::vector<Eigen::Vector2d> sorted_points_;  ///< its position
   int cols_ = 0, rows_ = 0;
   double cell_ = 1.0;
 };
