@@ -10,6 +10,8 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "online_stereo_calibration/core/frontend/orb_description.h"
+
 namespace osc {
 namespace {
 
@@ -167,11 +169,13 @@ double FeatureSet::distance(int i, const FeatureSet& other, int j) const {
 FeatureDetector::FeatureDetector(const FrontEndConfig& config) : config_(config) {
   const int candidates = 3 * config.max_features / 2;
   if (config.detector == "ORB") {
+    constexpr int kPatchSize = 19;
     auto orb =
         cv::ORB::create(candidates, static_cast<float>(config.orb_scale_factor), config.orb_levels,
-                        19, 0, 2, cv::ORB::FAST_SCORE, 19, config.fast_threshold);
+                        19, 0, 2, cv::ORB::FAST_SCORE, kPatchSize, config.fast_threshold);
     detector_ = orb;
     describer_ = orb;
+    if (config.orb_levels == 1) orb_description_ = std::make_unique<OrbDescription>(kPatchSize);
   } else if (config.detector == "FAST_ORB") {
     detector_ = cv::FastFeatureDetector::create(config.fast_threshold, true);
     describer_ = cv::ORB::create(candidates, 1.2f, 1, 19, 0, 2, cv::ORB::FAST_SCORE, 19,
@@ -250,7 +254,10 @@ FeatureSet FeatureDetector::detect(const cv::Mat& mono, const CameraModel& camer
                                                                 &unused);
                                 }),
                  selected.end());
-  if (!selected.empty()) describer_->compute(mono, selected, descriptors);
+  if (!selected.empty() &&
+      !(orb_description_ && orb_description_->compute(mono, selected, &descriptors))) {
+    describer_->compute(mono, selected, descriptors);
+  }
   set.descriptors = descriptors;
   set.binary = descriptors.empty() || descriptors.depth() == CV_8U;
   set.raw.reserve(selected.size());

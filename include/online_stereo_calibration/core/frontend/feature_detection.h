@@ -19,6 +19,8 @@ class Feature2D;
 
 namespace osc {
 
+class OrbDescription;
+
 /// Converts a CV_8UC1, CV_16UC1 (scaled by its bit depth), CV_8UC3 (BGR) or CV_8UC4 (BGRA)
 /// image to mono8 and checks it: not empty, at least config.min_image_size, the size the
 /// intrinsics say, some contrast (not all black / saturated). Returns "" if usable, else a
@@ -82,6 +84,8 @@ class FeatureDetector {
   FrontEndConfig config_;
   cv::Ptr<cv::Feature2D> detector_;
   cv::Ptr<cv::Feature2D> describer_;
+  /// ORB on one level: its descriptors computed by OrbDescription (the same bits, faster).
+  std::unique_ptr<OrbDescription> orb_description_;
 };
 
 }  // namespace osc

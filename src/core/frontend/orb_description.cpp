@@ -1,0 +1,91 @@
+#include "online_stereo_calibration/core/frontend/orb_description.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace osc {
+
+OrbDescription::OrbDescription(int patch_size) {
+  if (patch_size < 2 || patch_size == 31) {
+    throw std::invalid_argument("OrbDescription: patch size " + std::to_string(patch_size) +
+                                " (>= 2, not ORB's learned 31)");
+  }
+  // ORB's random pattern for patch sizes other than 31: a fixed seed, x then y of each point
+  // uniform in [-patch/2, patch/2].
+  cv::RNG rng(0x34985739);
+  pattern_x_.resize(kPoints);
+  pattern_y_.resize(kPoints);
+  for (int i = 0; i < kPoints; ++i) {
+    pattern_x_[static_cast<size_t>(i)] =
+        static_cast<float>(rng.uniform(-patch_size / 2, patch_size / 2 + 1));
+    pattern_y_[static_cast<size_t>(i)] =
+        static_cast<float>(rng.uniform(-patch_size / 2, patch_size / 2 + 1));
+  }
+  // The farthest a rotated pattern point can land (rounded).
+  border_ = static_cast<int>(std::ceil((patch_size / 2) * std::sqrt(2.0))) + 1;
+}
+
+bool OrbDescription::compute(const cv::Mat& mono, const std::vector<cv::KeyPoint>& keypoints,
+                             cv::Mat* descriptors) const {
+  CV_Assert(mono.type() == CV_8UC1);
+  for (const cv::KeyPoint& k : keypoints) {
+    const int x = cvRound(k.pt.x), y = cvRound(k.pt.y);
+    if (k.octave != 0 || x < border_ || y < border_ || x >= mono.cols - border_ ||
+        y >= mono.rows - border_) {
+      return false;
+    }
+  }
+  // ORB's smoothing before the tests, done as cv::ORB does it: in place, inside a copy of
+  // the image with a mirrored border (filtering the bare image gives values that differ by
+  // one grey level at some pixels, and so different bits).
+  constexpr int kOrbBorder = 20;  // cv::ORB's for edgeThreshold 19
+  cv::Mat extended;
+  cv::copyMakeBorder(mono, extended, kOrbBorder, kOrbBorder, kOrbBorder, kOrbBorder,
+                     cv::BORDER_REFLECT_101);
+  cv::Mat blurred = extended(cv::Rect(kOrbBorder, kOrbBorder, mono.cols, mono.rows));
+  cv::GaussianBlur(blurred, blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+  const int step = static_cast<int>(blurred.step[0]);
+  descriptors->create(static_cast<int>(keypoints.size()), kPoints / 16, CV_8U);
+  alignas(16) int offset[kPoints];
+  for (size_t j = 0; j < keypoints.size(); ++j) {
+    const cv::KeyPoint& k = keypoints[j];
+    // The same float arithmetic as cv::ORB (angle in float, cos/sin rounded to float,
+    // coordinates rounded to nearest even), so every test reads the same pixels.
+    const float angle = k.angle * static_cast<float>(CV_PI / 180.f);
+    const float a = static_cast<float>(std::cos(static_cast<double>(angle)));
+    const float b = static_cast<float>(std::sin(static_cast<double>(angle)));
+    int i = 0;
+#if CV_SIMD128
+    const cv::v_float32x4 va = cv::v_setall_f32(a), vb = cv::v_setall_f32(b);
+    const cv::v_int32x4 vstep = cv::v_setall_s32(step);
+    for (; i < kPoints; i += 4) {
+      const cv::v_float32x4 px = cv::v_load(&pattern_x_[static_cast<size_t>(i)]);
+      const cv::v_float32x4 py = cv::v_load(&pattern_y_[static_cast<size_t>(i)]);
+      const cv::v_int32x4 ix = cv::v_round(px * va - py * vb);
+      const cv::v_int32x4 iy = cv::v_round(px * vb + py * va);
+      cv::v_store_aligned(offset + i, iy * vstep + ix);
+    }
+#endif
+    for (; i < kPoints; ++i) {
+      const float px = pattern_x_[static_cast<size_t>(i)], py = pattern_y_[static_cast<size_t>(i)];
+      offset[i] = cvRound(px * b + py * a) * step + cvRound(px * a - py * b);
+    }
+    const unsigned char* center = blurred.ptr<unsigned char>(cvRound(k.pt.y)) + cvRound(k.pt.x);
+    unsigned char* out = descriptors->ptr<unsigned char>(static_cast<int>(j));
+    for (int byte = 0; byte < kPoints / 16; ++byte) {
+      const int* o = offset + 16 * byte;
+      int value = 0;
+      for (int bit = 0; bit < 8; ++bit) {
+        value |= (center[o[2 * bit]] < center[o[2 * bit + 1]]) << bit;
+      }
+      out[byte] = static_cast<unsigned char>(value);
+    }
+  }
+  return true;
+}
+
+}  // namespace osc
