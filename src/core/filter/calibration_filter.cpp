@@ -87,6 +87,38 @@ struct CalibrationFilter::PointInnovation {
   double nis_left = 0.0;  ///< left image only
 };
 
+/// predict()'s inputs (the state it starts from, after the excitation update) and outputs.
+struct CalibrationFilter::Prediction {
+  // Inputs.
+  MotionIncrement motion;
+  Eigen::Matrix3d R_excited;
+  StereoExtrinsics extrinsics;
+  Matrix12d covariance;
+  std::vector<TrackedPoint> points;
+  // Outputs.
+  Matrix12d predicted_covariance;
+  std::vector<TrackedPoint> predicted_points;
+  MatrixXd P;
+  std::vector<bool> failed;
+};
+
+namespace {
+
+/// Exactly equal (so that a reused prediction is bit for bit the one computed).
+template <typename Point>
+bool samePoints(const std::vector<Point>& a, const std::vector<Point>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i].id != b[i].id || a[i].mean != b[i].mean || a[i].D != b[i].D ||
+        a[i].B.rows() != b[i].B.rows() || a[i].B.cols() != b[i].B.cols() || a[i].B != b[i].B) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoIntrinsics& intrinsics)
     : config_(config), excitation_(config), intrinsics_(intrinsics) {
   const std::vector<std::string> problems = config.validate();
@@ -360,7 +392,39 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   return true;
 }
 
-MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<bool>* failed) {
+MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<bool>* failed,
+                                    bool remember) {
+  const Eigen::Matrix3d R_excited = excitation_.excitedRotation(motion.T_prev_curr.linear());
+  if (const std::shared_ptr<const Prediction> last = std::move(last_prediction_)) {
+    if (last->motion.dt == motion.dt &&
+        last->motion.T_prev_curr.matrix() == motion.T_prev_curr.matrix() &&
+        last->R_excited == R_excited &&
+        last->extrinsics.T_veh_caml.matrix() == extrinsics_.T_veh_caml.matrix() &&
+        last->extrinsics.T_caml_camr.matrix() == extrinsics_.T_caml_camr.matrix() &&
+        last->covariance == covariance_ && samePoints(last->points, points_)) {
+      covariance_ = last->predicted_covariance;
+      points_ = last->predicted_points;
+      *failed = last->failed;
+      return last->P;
+    }
+  }
+  if (!remember) return predictAnew(motion, failed);
+  auto prediction = std::make_shared<Prediction>();
+  prediction->motion = motion;
+  prediction->R_excited = R_excited;
+  prediction->extrinsics = extrinsics_;
+  prediction->covariance = covariance_;
+  prediction->points = points_;
+  const MatrixXd P = predictAnew(motion, failed);
+  prediction->predicted_covariance = covariance_;
+  prediction->predicted_points = points_;
+  prediction->P = P;
+  prediction->failed = *failed;
+  last_prediction_ = std::move(prediction);
+  return P;
+}
+
+MatrixXd CalibrationFilter::predictAnew(const MotionIncrement& motion, std::vector<bool>* failed) {
   applyCalibrationDrift(motion.dt);
   const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
   const int G = shared ? layout::kAugmentedDim : layout::kCalibrationDim;
@@ -421,7 +485,8 @@ std::vector<PredictedObservation> CalibrationFilter::predictObservations(
   CalibrationFilter scratch = *this;  // the prediction must not touch this filter
   scratch.excitation_.update(motion.T_prev_curr.linear(), motion.dt);
   std::vector<bool> failed;
-  const MatrixXd P = scratch.predict(motion, &failed);
+  const MatrixXd P = scratch.predict(motion, &failed, /*remember=*/true);
+  last_prediction_ = scratch.last_prediction_;  // for the step with this motion
   const double v = config_.pixel_noise * config_.pixel_noise;
   const Eigen::Vector4d variance(v, v, v, v);
   const Eigen::Vector4d unknown = Eigen::Vector4d::Constant(std::nan(""));
