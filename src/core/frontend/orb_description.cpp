@@ -61,13 +61,15 @@ bool OrbDescription::compute(const cv::Mat& mono, const std::vector<cv::KeyPoint
     int i = 0;
 #if CV_SIMD128
     const cv::v_float32x4 va = cv::v_setall_f32(a), vb = cv::v_setall_f32(b);
-    const cv::v_int32x4 vstep = cv::v_setall_s32(step);
+    // The offset row * step + column in float: exact (integers far below 2^24), and cheaper
+    // than a 32-bit integer product, which SSE2 lacks.
+    const cv::v_float32x4 vstep = cv::v_setall_f32(static_cast<float>(step));
     for (; i < kPoints; i += 4) {
       const cv::v_float32x4 px = cv::v_load(&pattern_x_[static_cast<size_t>(i)]);
       const cv::v_float32x4 py = cv::v_load(&pattern_y_[static_cast<size_t>(i)]);
-      const cv::v_int32x4 ix = cv::v_round(px * va - py * vb);
-      const cv::v_int32x4 iy = cv::v_round(px * vb + py * va);
-      cv::v_store_aligned(offset + i, iy * vstep + ix);
+      const cv::v_float32x4 ix = cv::v_cvt_f32(cv::v_round(px * va - py * vb));
+      const cv::v_float32x4 iy = cv::v_cvt_f32(cv::v_round(px * vb + py * va));
+      cv::v_store_aligned(offset + i, cv::v_round(iy * vstep + ix));
     }
 #endif
     for (; i < kPoints; ++i) {
