@@ -100,6 +100,15 @@ struct CalibrationFilter::Prediction {
   std::vector<TrackedPoint> predicted_points;
   MatrixXd P;
   std::vector<bool> failed;
+  /// The measurement UT of each predicted point (by index), filled by linearizeMeasurement
+  /// on the predicted state: the step linearises the same points from the same state.
+  struct MeasurementUt {
+    MatrixXd joint_covariance;  ///< the UT's input covariance
+    Eigen::Vector3d mean;       ///< the point's mean (the function's argument)
+    Eigen::Matrix4d T_caml_camr;
+    UnscentedResult ut;
+  };
+  mutable std::vector<std::shared_ptr<const MeasurementUt>> measurement_uts;
 };
 
 namespace {
@@ -405,6 +414,7 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
       covariance_ = last->predicted_covariance;
       points_ = last->predicted_points;
       *failed = last->failed;
+      last_prediction_ = last;  // its measurement UTs, for linearizeMeasurement
       return last->P;
     }
   }
@@ -443,8 +453,8 @@ MatrixXd CalibrationFilter::predictAnew(const MotionIncrement& motion, std::vect
 }
 
 bool CalibrationFilter::linearizeMeasurement(size_t i, const MatrixXd& P, const Eigen::Vector4d& z,
-                                             const Eigen::Vector4d& variance,
-                                             PointInnovation* inn) const {
+                                             const Eigen::Vector4d& variance, PointInnovation* inn,
+                                             bool remember) const {
   // Seed eq. 29-30 through a UT on [x_camr, p], as a regression on the global error.
   const TrackedPoint& point = points_[i];
   const std::vector<int> camr = range(layout::kCamr, layout::kPoseDim);
@@ -456,11 +466,33 @@ bool CalibrationFilter::linearizeMeasurement(size_t i, const MatrixXd& P, const 
     *y = projected;
     return true;
   };
-  UnscentedResult ut;
-  if (!unscentedTransformWithFallback(VectorXd::Zero(9), jointCovariance(P, camr, point.B, point.D),
-                                      observe, ut_, &ut)) {
-    return false;
+  const MatrixXd joint = jointCovariance(P, camr, point.B, point.D);
+  // The UT of the same inputs computed by predictObservations (exactly equal inputs, so
+  // exactly the same result), else anew.
+  std::shared_ptr<const Prediction::MeasurementUt> reused;
+  if (last_prediction_ && i < last_prediction_->measurement_uts.size()) {
+    reused = last_prediction_->measurement_uts[i];
+    if (reused &&
+        !(reused->mean == point.mean && reused->T_caml_camr == extrinsics_.T_caml_camr.matrix() &&
+          reused->joint_covariance == joint)) {
+      reused.reset();
+    }
   }
+  if (!reused) {
+    auto computed = std::make_shared<Prediction::MeasurementUt>();
+    if (!unscentedTransformWithFallback(VectorXd::Zero(9), joint, observe, ut_, &computed->ut)) {
+      return false;
+    }
+    computed->joint_covariance = joint;
+    computed->mean = point.mean;
+    computed->T_caml_camr = extrinsics_.T_caml_camr.matrix();
+    if (remember && last_prediction_) {
+      last_prediction_->measurement_uts.resize(points_.size());
+      last_prediction_->measurement_uts[i] = computed;
+    }
+    reused = computed;
+  }
+  const UnscentedResult& ut = reused->ut;
   inn->point = i;
   inn->predicted = ut.mean;
   inn->residual = z - ut.mean;
@@ -492,7 +524,7 @@ std::vector<PredictedObservation> CalibrationFilter::predictObservations(
   const Eigen::Vector4d unknown = Eigen::Vector4d::Constant(std::nan(""));
   for (size_t i = 0; i < scratch.points_.size(); ++i) {
     PointInnovation inn;
-    if (failed[i] || !scratch.linearizeMeasurement(i, P, unknown, variance, &inn)) continue;
+    if (failed[i] || !scratch.linearizeMeasurement(i, P, unknown, variance, &inn, true)) continue;
     PredictedObservation prediction;
     prediction.id = scratch.points_[i].id;
     prediction.z = inn.predicted;

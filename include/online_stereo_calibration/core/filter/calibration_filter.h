@@ -133,8 +133,10 @@ class CalibrationFilter {
   Eigen::MatrixXd predict(const MotionIncrement& motion, std::vector<bool>* failed,
                           bool remember = false);
   Eigen::MatrixXd predictAnew(const MotionIncrement& motion, std::vector<bool>* failed);
+  /// remember: keep the point's UT in last_prediction_ for the step (predictObservations).
   bool linearizeMeasurement(size_t index, const Eigen::MatrixXd& P, const Eigen::Vector4d& z,
-                            const Eigen::Vector4d& variance, PointInnovation* innovation) const;
+                            const Eigen::Vector4d& variance, PointInnovation* innovation,
+                            bool remember = false) const;
   void applyCalibrationDrift(double dt);
   void predictPoints(const MotionIncrement& motion, const Eigen::MatrixXd& P_global,
                      std::vector<bool>* failed);
