@@ -9,11 +9,16 @@
 
 namespace {
 
-constexpr int kPatchSize = 19;
+constexpr int kPatchSize = 19, kEdgeThreshold = 19, kFastThreshold = 12, kKeypoints = 3000;
 
 cv::Ptr<cv::ORB> orb() {
   // As FeatureDetector creates it for detector ORB with orb_levels 1.
-  return cv::ORB::create(3000, 1.2f, 1, 19, 0, 2, cv::ORB::FAST_SCORE, kPatchSize, 12);
+  return cv::ORB::create(kKeypoints, 1.2f, 1, kEdgeThreshold, 0, 2, cv::ORB::FAST_SCORE, kPatchSize,
+                         kFastThreshold);
+}
+
+osc::OrbDescription description() {
+  return osc::OrbDescription(kPatchSize, kEdgeThreshold, kFastThreshold);
 }
 
 /// Smoothed noise: corners everywhere, many ties after ORB's own smoothing.
@@ -32,6 +37,26 @@ int differingRows(const cv::Mat& a, const cv::Mat& b) {
   return rows;
 }
 
+TEST(OrbDescription, DetectAndOrientGiveOpenCvOrbsKeypointsInItsOrder) {
+  for (int seed : {1, 2}) {
+    const cv::Mat image = texture(640, 480, seed);
+    std::vector<cv::KeyPoint> expected, actual;
+    orb()->detect(image, expected);
+    const osc::OrbDescription orb_description = description();
+    orb_description.detect(image, kKeypoints, &actual);
+    orb_description.orient(image, &actual);
+    ASSERT_GT(expected.size(), 1000u);
+    ASSERT_EQ(actual.size(), expected.size());
+    int different = 0;
+    for (size_t i = 0; i < actual.size(); ++i) {
+      const cv::KeyPoint &a = actual[i], &e = expected[i];
+      different += a.pt != e.pt || a.response != e.response || a.angle != e.angle ||
+                   a.octave != e.octave || a.size != e.size;
+    }
+    EXPECT_EQ(different, 0) << "seed " << seed;
+  }
+}
+
 TEST(OrbDescription, SameBitsAsOpenCvOrbOnItsKeypoints) {
   for (int seed : {1, 2}) {
     const cv::Mat image = texture(640, 480, seed);
@@ -43,7 +68,7 @@ TEST(OrbDescription, SameBitsAsOpenCvOrbOnItsKeypoints) {
     orb()->compute(image, described, expected);
     ASSERT_EQ(described.size(), keypoints.size());  // cv::ORB dropped none
 
-    ASSERT_TRUE(osc::OrbDescription(kPatchSize).compute(image, keypoints, &actual));
+    ASSERT_TRUE(description().compute(image, keypoints, &actual));
     ASSERT_EQ(actual.rows, expected.rows);
     ASSERT_EQ(actual.cols, expected.cols);
     EXPECT_EQ(differingRows(actual, expected), 0) << "seed " << seed;
@@ -64,26 +89,26 @@ TEST(OrbDescription, SameBitsAtEveryAngle) {
   cv::Mat expected, actual;
   orb()->compute(image, described, expected);
   ASSERT_EQ(described.size(), keypoints.size());
-  ASSERT_TRUE(osc::OrbDescription(kPatchSize).compute(image, keypoints, &actual));
+  ASSERT_TRUE(description().compute(image, keypoints, &actual));
   EXPECT_EQ(differingRows(actual, expected), 0);
 }
 
 TEST(OrbDescription, RefusesKeypointsTooCloseToTheBorderOrOnAnotherLevel) {
   const cv::Mat image = texture(100, 80, 4);
-  const osc::OrbDescription description(kPatchSize);
+  const osc::OrbDescription orb_description = description();
   cv::Mat descriptors;
-  cv::KeyPoint near_border(cv::Point2f(static_cast<float>(description.border() - 1), 40.0f),
+  cv::KeyPoint near_border(cv::Point2f(static_cast<float>(orb_description.border() - 1), 40.0f),
                            kPatchSize);
   near_border.octave = 0;
-  EXPECT_FALSE(description.compute(image, {near_border}, &descriptors));
+  EXPECT_FALSE(orb_description.compute(image, {near_border}, &descriptors));
   cv::KeyPoint other_level(cv::Point2f(50.0f, 40.0f), kPatchSize);
   other_level.octave = 1;
-  EXPECT_FALSE(description.compute(image, {other_level}, &descriptors));
+  EXPECT_FALSE(orb_description.compute(image, {other_level}, &descriptors));
   cv::KeyPoint inside(cv::Point2f(50.0f, 40.0f), kPatchSize);
   inside.octave = 0;
-  EXPECT_TRUE(description.compute(image, {inside}, &descriptors));
+  EXPECT_TRUE(orb_description.compute(image, {inside}, &descriptors));
   EXPECT_EQ(descriptors.rows, 1);
-  EXPECT_THROW(osc::OrbDescription(31), std::invalid_argument);
+  EXPECT_THROW(osc::OrbDescription(31, kEdgeThreshold, kFastThreshold), std::invalid_argument);
 }
 
 }  // namespace

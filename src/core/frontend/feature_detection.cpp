@@ -19,6 +19,9 @@ std::string sizeText(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
 
+/// Keypoints the detector keeps before the grid spreading (1.5x max_features).
+int candidateCount(const FrontEndConfig& config) { return 3 * config.max_features / 2; }
+
 std::string typeText(int type) {
   return "type " + std::to_string(type) + " (depth " + std::to_string(CV_MAT_DEPTH(type)) + ", " +
          std::to_string(CV_MAT_CN(type)) + " channel(s))";
@@ -167,15 +170,18 @@ double FeatureSet::distance(int i, const FeatureSet& other, int j) const {
 }
 
 FeatureDetector::FeatureDetector(const FrontEndConfig& config) : config_(config) {
-  const int candidates = 3 * config.max_features / 2;
+  const int candidates = candidateCount(config);
   if (config.detector == "ORB") {
-    constexpr int kPatchSize = 19;
-    auto orb =
-        cv::ORB::create(candidates, static_cast<float>(config.orb_scale_factor), config.orb_levels,
-                        19, 0, 2, cv::ORB::FAST_SCORE, kPatchSize, config.fast_threshold);
+    constexpr int kPatchSize = 19, kEdgeThreshold = 19;
+    auto orb = cv::ORB::create(candidates, static_cast<float>(config.orb_scale_factor),
+                               config.orb_levels, kEdgeThreshold, 0, 2, cv::ORB::FAST_SCORE,
+                               kPatchSize, config.fast_threshold);
     detector_ = orb;
     describer_ = orb;
-    if (config.orb_levels == 1) orb_description_ = std::make_unique<OrbDescription>(kPatchSize);
+    if (config.orb_levels == 1) {
+      orb_description_ =
+          std::make_unique<OrbDescription>(kPatchSize, kEdgeThreshold, config.fast_threshold);
+    }
   } else if (config.detector == "FAST_ORB") {
     detector_ = cv::FastFeatureDetector::create(config.fast_threshold, true);
     describer_ = cv::ORB::create(candidates, 1.2f, 1, 19, 0, 2, cv::ORB::FAST_SCORE, 19,
@@ -204,7 +210,12 @@ FeatureDetector::~FeatureDetector() = default;
 
 FeatureSet FeatureDetector::detect(const cv::Mat& mono, const CameraModel& camera) const {
   std::vector<cv::KeyPoint> all;
-  detector_->detect(mono, all);
+  if (orb_description_) {
+    // ORB's keypoints without their orientation: only the ones kept below get one.
+    orb_description_->detect(mono, candidateCount(config_), &all);
+  } else {
+    detector_->detect(mono, all);
+  }
   const float border = static_cast<float>(config_.border);
   all.erase(std::remove_if(all.begin(), all.end(),
                            [&](const cv::KeyPoint& k) {
@@ -254,6 +265,7 @@ FeatureSet FeatureDetector::detect(const cv::Mat& mono, const CameraModel& camer
                                                                 &unused);
                                 }),
                  selected.end());
+  if (orb_description_) orb_description_->orient(mono, &selected);
   if (!selected.empty() &&
       !(orb_description_ && orb_description_->compute(mono, selected, &descriptors))) {
     describer_->compute(mono, selected, descriptors);

@@ -5,14 +5,30 @@
 #include <string>
 
 #include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace osc {
 
-OrbDescription::OrbDescription(int patch_size) {
+OrbDescription::OrbDescription(int patch_size, int edge_threshold, int fast_threshold)
+    : patch_size_(patch_size), edge_threshold_(edge_threshold), fast_threshold_(fast_threshold) {
   if (patch_size < 2 || patch_size == 31) {
     throw std::invalid_argument("OrbDescription: patch size " + std::to_string(patch_size) +
                                 " (>= 2, not ORB's learned 31)");
+  }
+  // Half-width of each row of the circular patch of the orientation, made symmetric in the
+  // two axes as cv::ORB makes it: rows up to 45 degrees from the circle, the rest mirrored.
+  const int r = patch_size / 2;
+  half_width_.assign(static_cast<size_t>(r + 2), 0);
+  const int v_max = cvFloor(r * std::sqrt(2.f) / 2 + 1);
+  const int v_min = cvCeil(r * std::sqrt(2.f) / 2);
+  for (int v = 0; v <= v_max; ++v) {
+    half_width_[static_cast<size_t>(v)] = cvRound(std::sqrt(static_cast<double>(r) * r - v * v));
+  }
+  for (int v = r, v0 = 0; v >= v_min; --v) {
+    while (half_width_[static_cast<size_t>(v0)] == half_width_[static_cast<size_t>(v0 + 1)]) ++v0;
+    half_width_[static_cast<size_t>(v)] = v0;
+    ++v0;
   }
   // ORB's random pattern for patch sizes other than 31: a fixed seed, x then y of each point
   // uniform in [-patch/2, patch/2].
@@ -27,6 +43,45 @@ OrbDescription::OrbDescription(int patch_size) {
   }
   // The farthest a rotated pattern point can land (rounded).
   border_ = static_cast<int>(std::ceil((patch_size / 2) * std::sqrt(2.0))) + 1;
+}
+
+void OrbDescription::detect(const cv::Mat& mono, int max_keypoints,
+                            std::vector<cv::KeyPoint>* keypoints) const {
+  // cv::ORB on one level: FAST with non-maximum suppression, nothing within edgeThreshold of
+  // the border, the best nfeatures by FAST score.
+  cv::FAST(mono, *keypoints, fast_threshold_, true);
+  cv::KeyPointsFilter::runByImageBorder(*keypoints, mono.size(), edge_threshold_);
+  cv::KeyPointsFilter::retainBest(*keypoints, max_keypoints);
+  for (cv::KeyPoint& k : *keypoints) {
+    k.octave = 0;
+    k.size = static_cast<float>(patch_size_);
+  }
+}
+
+void OrbDescription::orient(const cv::Mat& mono, std::vector<cv::KeyPoint>* keypoints) const {
+  CV_Assert(mono.type() == CV_8UC1);
+  const int r = patch_size_ / 2;
+  const int step = static_cast<int>(mono.step[0]);
+  for (cv::KeyPoint& k : *keypoints) {
+    const int cx = cvRound(k.pt.x), cy = cvRound(k.pt.y);
+    CV_Assert(cx >= r && cy >= r && cx < mono.cols - r && cy < mono.rows - r);
+    const unsigned char* center = mono.ptr<unsigned char>(cy) + cx;
+    // First moments of the intensity over the circular patch (integers: exact in any order).
+    int m_10 = 0, m_01 = 0;
+    for (int u = -r; u <= r; ++u) m_10 += u * center[u];
+    for (int v = 1; v <= r; ++v) {
+      const int d = half_width_[static_cast<size_t>(v)];
+      const unsigned char* below = center + v * step;
+      const unsigned char* above = center - v * step;
+      int difference = 0;
+      for (int u = -d; u <= d; ++u) {
+        difference += below[u] - above[u];
+        m_10 += u * (below[u] + above[u]);
+      }
+      m_01 += v * difference;
+    }
+    k.angle = cv::fastAtan2(static_cast<float>(m_01), static_cast<float>(m_10));
+  }
 }
 
 bool OrbDescription::compute(const cv::Mat& mono, const std::vector<cv::KeyPoint>& keypoints,
