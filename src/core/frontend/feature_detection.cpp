@@ -126,7 +126,7 @@ void SpatialGrid::query(const Eigen::Vector2d& min, const Eigen::Vector2d& max,
 
 // The x86-64 baseline has no popcount instruction (GCC calls a library routine, ~2 % of a
 // frame): a second version for CPUs with POPCNT, chosen at load time.
-#if defined(__x86_64__) && defined(__GNUC__) && defined(__linux__)
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__GLIBC__)  // ifunc: glibc
 #define OSC_WITH_POPCNT_CLONE __attribute__((target_clones("popcnt", "default")))
 #else
 #define OSC_WITH_POPCNT_CLONE
