@@ -305,3 +305,47 @@ TEST_F(FilterWithPoints, PredictedObservationsBracketTheMeasurementAndLeaveTheFi
 
 }  // namespace
 }  // namespace osc
+
+namespace osc {
+namespace {
+
+/// The step after predictObservations reuses its prediction: it must give bit for bit what
+/// a step without it gives, and not reuse it after a different motion or another state.
+TEST_F(FilterWithPoints, StepAfterPredictObservationsIsBitIdentical) {
+  auto expectSame = [](const CalibrationFilter& a, const CalibrationFilter& b) {
+    EXPECT_TRUE(a.covariance() == b.covariance());
+    EXPECT_TRUE(a.extrinsics().T_veh_caml.matrix() == b.extrinsics().T_veh_caml.matrix());
+    EXPECT_TRUE(a.extrinsics().T_caml_camr.matrix() == b.extrinsics().T_caml_camr.matrix());
+    ASSERT_EQ(a.pointCount(), b.pointCount());
+    for (size_t i = 0; i < a.pointCount(); ++i) {
+      EXPECT_EQ(a.points()[i].id, b.points()[i].id);
+      EXPECT_TRUE(a.points()[i].position_lopt == b.points()[i].position_lopt);
+    }
+  };
+  CalibrationFilter plain = filter, predicted = filter, other_motion = filter, changed = filter;
+  const MotionIncrement motion = problem.motion(4);
+  const auto measurements = problem.measure(4, 0.5);
+  plain.step(motion, measurements);
+
+  predicted.predictObservations(motion);
+  predicted.step(motion, measurements);
+  expectSame(predicted, plain);
+
+  MotionIncrement wrong = motion;
+  wrong.T_prev_curr.translation().x() += 0.5;
+  other_motion.predictObservations(wrong);
+  other_motion.step(motion, measurements);
+  expectSame(other_motion, plain);
+
+  // The state changed between the two: the prediction must not be reused.
+  changed.predictObservations(motion);
+  changed.removePoint(measurements.front().id);
+  CalibrationFilter changed_plain = filter;
+  changed_plain.removePoint(measurements.front().id);
+  changed.step(motion, measurements);
+  changed_plain.step(motion, measurements);
+  expectSame(changed, changed_plain);
+}
+
+}  // namespace
+}  // namespace osc

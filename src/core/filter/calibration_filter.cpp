@@ -87,6 +87,47 @@ struct CalibrationFilter::PointInnovation {
   double nis_left = 0.0;            ///< left image only
 };
 
+/// predict()'s inputs (the state it starts from, after the excitation update) and outputs.
+struct CalibrationFilter::Prediction {
+  // Inputs.
+  MotionIncrement motion;
+  Eigen::Matrix3d R_excited;
+  StereoExtrinsics extrinsics;
+  Matrix12d covariance;
+  std::vector<TrackedPoint> points;
+  // Outputs.
+  Matrix12d predicted_covariance;
+  std::vector<TrackedPoint> predicted_points;
+  MatrixXd P;
+  std::vector<bool> failed;
+  /// The measurement UT of each predicted point (by index), filled by linearizeMeasurement
+  /// on the predicted state: the step linearises the same points from the same state.
+  struct MeasurementUt {
+    MatrixXd joint_covariance;  ///< the UT's input covariance
+    Eigen::Vector3d mean;       ///< the point's mean (the function's argument)
+    Eigen::Matrix4d T_caml_camr;
+    UnscentedResult ut;
+  };
+  mutable std::vector<std::shared_ptr<const MeasurementUt>> measurement_uts;
+};
+
+namespace {
+
+/// Exactly equal (so that a reused prediction is bit for bit the one computed).
+template <typename Point>
+bool samePoints(const std::vector<Point>& a, const std::vector<Point>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i].id != b[i].id || a[i].mean != b[i].mean || a[i].D != b[i].D ||
+        a[i].B.rows() != b[i].B.rows() || a[i].B.cols() != b[i].B.cols() || a[i].B != b[i].B) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoIntrinsics& intrinsics)
     : config_(config), excitation_(config), intrinsics_(intrinsics) {
   const std::vector<std::string> problems = config.validate();
@@ -370,7 +411,40 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   return true;
 }
 
-MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<bool>* failed) {
+MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<bool>* failed,
+                                    bool remember) {
+  const Eigen::Matrix3d R_excited = excitation_.excitedRotation(motion.T_prev_curr.linear());
+  if (const std::shared_ptr<const Prediction> last = std::move(last_prediction_)) {
+    if (last->motion.dt == motion.dt &&
+        last->motion.T_prev_curr.matrix() == motion.T_prev_curr.matrix() &&
+        last->R_excited == R_excited &&
+        last->extrinsics.T_veh_caml.matrix() == extrinsics_.T_veh_caml.matrix() &&
+        last->extrinsics.T_caml_camr.matrix() == extrinsics_.T_caml_camr.matrix() &&
+        last->covariance == covariance_ && samePoints(last->points, points_)) {
+      covariance_ = last->predicted_covariance;
+      points_ = last->predicted_points;
+      *failed = last->failed;
+      last_prediction_ = last;  // its measurement UTs, for linearizeMeasurement
+      return last->P;
+    }
+  }
+  if (!remember) return predictAnew(motion, failed);
+  auto prediction = std::make_shared<Prediction>();
+  prediction->motion = motion;
+  prediction->R_excited = R_excited;
+  prediction->extrinsics = extrinsics_;
+  prediction->covariance = covariance_;
+  prediction->points = points_;
+  const MatrixXd P = predictAnew(motion, failed);
+  prediction->predicted_covariance = covariance_;
+  prediction->predicted_points = points_;
+  prediction->P = P;
+  prediction->failed = *failed;
+  last_prediction_ = std::move(prediction);
+  return P;
+}
+
+MatrixXd CalibrationFilter::predictAnew(const MotionIncrement& motion, std::vector<bool>* failed) {
   applyCalibrationDrift(motion.dt);
   const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
   const int G = shared ? layout::kAugmentedDim : layout::kCalibrationDim;
@@ -389,8 +463,8 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
 }
 
 bool CalibrationFilter::linearizeMeasurement(size_t i, const MatrixXd& P, const Eigen::Vector4d& z,
-                                             const Eigen::Vector4d& variance,
-                                             PointInnovation* inn) const {
+                                             const Eigen::Vector4d& variance, PointInnovation* inn,
+                                             bool remember) const {
   // Seed eq. 29-30 through a UT on [x_camr, p], as a regression on the global error.
   const TrackedPoint& point = points_[i];
   const std::vector<int> camr = range(layout::kCamr, layout::kPoseDim);
@@ -403,11 +477,33 @@ bool CalibrationFilter::linearizeMeasurement(size_t i, const MatrixXd& P, const 
     *y = projected;
     return true;
   };
-  UnscentedResult ut;
-  if (!unscentedTransformWithFallback(VectorXd::Zero(9), jointCovariance(P, camr, point.B, point.D),
-                                      observe, ut_, &ut)) {
-    return false;
+  const MatrixXd joint = jointCovariance(P, camr, point.B, point.D);
+  // The UT of the same inputs computed by predictObservations (exactly equal inputs, so
+  // exactly the same result), else anew.
+  std::shared_ptr<const Prediction::MeasurementUt> reused;
+  if (last_prediction_ && i < last_prediction_->measurement_uts.size()) {
+    reused = last_prediction_->measurement_uts[i];
+    if (reused &&
+        !(reused->mean == point.mean && reused->T_caml_camr == extrinsics_.T_caml_camr.matrix() &&
+          reused->joint_covariance == joint)) {
+      reused.reset();
+    }
   }
+  if (!reused) {
+    auto computed = std::make_shared<Prediction::MeasurementUt>();
+    if (!unscentedTransformWithFallback(VectorXd::Zero(9), joint, observe, ut_, &computed->ut)) {
+      return false;
+    }
+    computed->joint_covariance = joint;
+    computed->mean = point.mean;
+    computed->T_caml_camr = extrinsics_.T_caml_camr.matrix();
+    if (remember && last_prediction_) {
+      last_prediction_->measurement_uts.resize(points_.size());
+      last_prediction_->measurement_uts[i] = computed;
+    }
+    reused = computed;
+  }
+  const UnscentedResult& ut = reused->ut;
   inn->point = i;
   inn->predicted = ut.mean;
   inn->residual = z - ut.mean;
@@ -432,13 +528,14 @@ std::vector<PredictedObservation> CalibrationFilter::predictObservations(
   CalibrationFilter scratch = *this;  // the prediction must not touch this filter
   scratch.excitation_.update(motion.T_prev_curr.linear(), motion.dt);
   std::vector<bool> failed;
-  const MatrixXd P = scratch.predict(motion, &failed);
+  const MatrixXd P = scratch.predict(motion, &failed, /*remember=*/true);
+  last_prediction_ = scratch.last_prediction_;  // for the step with this motion
   const double v = config_.pixel_noise * config_.pixel_noise;
   const Eigen::Vector4d variance(v, v, v, v);
   const Eigen::Vector4d unknown = Eigen::Vector4d::Constant(std::nan(""));
   for (size_t i = 0; i < scratch.points_.size(); ++i) {
     PointInnovation inn;
-    if (failed[i] || !scratch.linearizeMeasurement(i, P, unknown, variance, &inn)) continue;
+    if (failed[i] || !scratch.linearizeMeasurement(i, P, unknown, variance, &inn, true)) continue;
     PredictedObservation prediction;
     prediction.id = scratch.points_[i].id;
     prediction.z = inn.predicted;

@@ -10,12 +10,17 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "online_stereo_calibration/core/frontend/orb_description.h"
+
 namespace osc {
 namespace {
 
 std::string sizeText(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
+
+/// Keypoints the detector keeps before the grid spreading (1.5x max_features).
+int candidateCount(const FrontEndConfig& config) { return 3 * config.max_features / 2; }
 
 std::string typeText(int type) {
   return "type " + std::to_string(type) + " (depth " + std::to_string(CV_MAT_DEPTH(type)) + ", " +
@@ -76,38 +81,59 @@ std::string toCheckedMono8(const cv::Mat& image, const CameraIntrinsics& intrins
 
 void SpatialGrid::build(const std::vector<Eigen::Vector2d>& points, int width, int height,
                         double cell) {
-  points_ = points;
   cell_ = std::max(cell, 1.0);
   cols_ = std::max(1, static_cast<int>(std::ceil(width / cell_)));
   rows_ = std::max(1, static_cast<int>(std::ceil(height / cell_)));
-  cells_.assign(static_cast<size_t>(cols_ * rows_), {});
+  // Counting sort by cell.
+  std::vector<int> cell_of(points.size());
+  cell_start_.assign(static_cast<size_t>(cols_ * rows_ + 1), 0);
   for (size_t i = 0; i < points.size(); ++i) {
     const int c = std::clamp(static_cast<int>(std::floor(points[i].x() / cell_)), 0, cols_ - 1);
     const int r = std::clamp(static_cast<int>(std::floor(points[i].y() / cell_)), 0, rows_ - 1);
-    cells_[static_cast<size_t>(r * cols_ + c)].push_back(static_cast<int>(i));
+    cell_of[i] = r * cols_ + c;
+    ++cell_start_[static_cast<size_t>(cell_of[i] + 1)];
+  }
+  for (size_t k = 1; k < cell_start_.size(); ++k) cell_start_[k] += cell_start_[k - 1];
+  std::vector<int> next(cell_start_.begin(), cell_start_.end() - 1);
+  sorted_index_.resize(points.size());
+  sorted_points_.resize(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const size_t slot = static_cast<size_t>(next[static_cast<size_t>(cell_of[i])]++);
+    sorted_index_[slot] = static_cast<int>(i);
+    sorted_points_[slot] = points[i];
   }
 }
 
 void SpatialGrid::query(const Eigen::Vector2d& min, const Eigen::Vector2d& max,
                         std::vector<int>* out) const {
-  if (cells_.empty() || !min.allFinite() || !max.allFinite()) return;
+  if (sorted_index_.empty() || !min.allFinite() || !max.allFinite()) return;
   const int c0 = std::clamp(static_cast<int>(std::floor(min.x() / cell_)), 0, cols_ - 1);
   const int c1 = std::clamp(static_cast<int>(std::floor(max.x() / cell_)), 0, cols_ - 1);
   const int r0 = std::clamp(static_cast<int>(std::floor(min.y() / cell_)), 0, rows_ - 1);
   const int r1 = std::clamp(static_cast<int>(std::floor(max.y() / cell_)), 0, rows_ - 1);
+  const double x_min = min.x(), x_max = max.x(), y_min = min.y(), y_max = max.y();
   for (int r = r0; r <= r1; ++r) {
-    for (int c = c0; c <= c1; ++c) {
-      for (int i : cells_[static_cast<size_t>(r * cols_ + c)]) {
-        const Eigen::Vector2d& p = points_[static_cast<size_t>(i)];
-        if (p.x() >= min.x() && p.x() <= max.x() && p.y() >= min.y() && p.y() <= max.y()) {
-          out->push_back(i);
-        }
+    const int first = cell_start_[static_cast<size_t>(r * cols_ + c0)];
+    const int last = cell_start_[static_cast<size_t>(r * cols_ + c1 + 1)];
+    for (int k = first; k < last; ++k) {
+      const Eigen::Vector2d& p = sorted_points_[static_cast<size_t>(k)];
+      if (p.x() >= x_min && p.x() <= x_max && p.y() >= y_min && p.y() <= y_max) {
+        out->push_back(sorted_index_[static_cast<size_t>(k)]);
       }
     }
   }
 }
 
-double hammingDistance(const unsigned char* a, const unsigned char* b, int bytes) {
+// The x86-64 baseline has no popcount instruction (GCC calls a library routine, ~2 % of a
+// frame): a second version for CPUs with POPCNT, chosen at load time.
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__GLIBC__)  // ifunc: glibc
+#define OSC_WITH_POPCNT_CLONE __attribute__((target_clones("popcnt", "default")))
+#else
+#define OSC_WITH_POPCNT_CLONE
+#endif
+
+OSC_WITH_POPCNT_CLONE double hammingDistance(const unsigned char* a, const unsigned char* b,
+                                             int bytes) {
   int bits = 0;
   int k = 0;
   for (; k + 8 <= bytes; k += 8) {
@@ -144,13 +170,18 @@ double FeatureSet::distance(int i, const FeatureSet& other, int j) const {
 }
 
 FeatureDetector::FeatureDetector(const FrontEndConfig& config) : config_(config) {
-  const int candidates = 3 * config.max_features / 2;
+  const int candidates = candidateCount(config);
   if (config.detector == "ORB") {
-    auto orb =
-        cv::ORB::create(candidates, static_cast<float>(config.orb_scale_factor), config.orb_levels,
-                        19, 0, 2, cv::ORB::FAST_SCORE, 19, config.fast_threshold);
+    constexpr int kPatchSize = 19, kEdgeThreshold = 19;
+    auto orb = cv::ORB::create(candidates, static_cast<float>(config.orb_scale_factor),
+                               config.orb_levels, kEdgeThreshold, 0, 2, cv::ORB::FAST_SCORE,
+                               kPatchSize, config.fast_threshold);
     detector_ = orb;
     describer_ = orb;
+    if (config.orb_levels == 1) {
+      orb_description_ =
+          std::make_unique<OrbDescription>(kPatchSize, kEdgeThreshold, config.fast_threshold);
+    }
   } else if (config.detector == "FAST_ORB") {
     detector_ = cv::FastFeatureDetector::create(config.fast_threshold, true);
     describer_ = cv::ORB::create(candidates, 1.2f, 1, 19, 0, 2, cv::ORB::FAST_SCORE, 19,
@@ -179,7 +210,12 @@ FeatureDetector::~FeatureDetector() = default;
 
 FeatureSet FeatureDetector::detect(const cv::Mat& mono, const CameraModel& camera) const {
   std::vector<cv::KeyPoint> all;
-  detector_->detect(mono, all);
+  if (orb_description_) {
+    // ORB's keypoints without their orientation: only the ones kept below get one.
+    orb_description_->detect(mono, candidateCount(config_), &all);
+  } else {
+    detector_->detect(mono, all);
+  }
   const float border = static_cast<float>(config_.border);
   all.erase(std::remove_if(all.begin(), all.end(),
                            [&](const cv::KeyPoint& k) {
@@ -229,7 +265,11 @@ FeatureSet FeatureDetector::detect(const cv::Mat& mono, const CameraModel& camer
                                                                 &unused);
                                 }),
                  selected.end());
-  if (!selected.empty()) describer_->compute(mono, selected, descriptors);
+  if (orb_description_) orb_description_->orient(mono, &selected);
+  if (!selected.empty() &&
+      !(orb_description_ && orb_description_->compute(mono, selected, &descriptors))) {
+    describer_->compute(mono, selected, descriptors);
+  }
   set.descriptors = descriptors;
   set.binary = descriptors.empty() || descriptors.depth() == CV_8U;
   set.raw.reserve(selected.size());

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <Eigen/LU>
+#include <opencv2/core/hal/intrin.hpp>
 
 namespace osc {
 namespace {
@@ -36,7 +37,20 @@ bool samplePatch(const cv::Mat& image, const Eigen::Vector2d& p, int h, std::vec
   for (int y = 0; y < n; ++y) {
     const unsigned char* r0 = image.ptr<unsigned char>(y0 + y) + x0;
     const unsigned char* r1 = r0 + image.step[0];
-    for (int x = 0; x < n; ++x) {
+    int x = 0;
+#if CV_SIMD128
+    // Four samples at a time, with the same operations in the same order as below.
+    const auto load = [](const unsigned char* p) {
+      return cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand_q(p)));
+    };
+    const cv::v_float32x4 v00 = cv::v_setall_f32(w00), v01 = cv::v_setall_f32(w01);
+    const cv::v_float32x4 v10 = cv::v_setall_f32(w10), v11 = cv::v_setall_f32(w11);
+    for (; x + 4 <= n; x += 4, o += 4) {
+      cv::v_store(o, v00 * load(r0 + x) + v01 * load(r0 + x + 1) + v10 * load(r1 + x) +
+                         v11 * load(r1 + x + 1));
+    }
+#endif
+    for (; x < n; ++x) {
       *o++ = w00 * r0[x] + w01 * r0[x + 1] + w10 * r1[x] + w11 * r1[x + 1];
     }
   }

@@ -96,11 +96,18 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   const Matrix12d& P = filter.covariance();
   matcher_.setGeometry(left_camera_.K(), right_camera_.K(), filter.extrinsics().T_caml_camr,
                        P.bottomRightCorner<6, 6>());
+  // PointTracker::track asks about one left keypoint against many right ones (the whole
+  // image when reacquiring): its seven lines are computed once, not per right keypoint.
+  int left_lines_of = -1;
+  EpipolarMatcher::Lines left_lines;
   auto on_band = [&](int l, int r) {
-    const Eigen::Vector2d& ul = left.undistorted[static_cast<size_t>(l)];
+    if (l != left_lines_of) {
+      left_lines = matcher_.lines(left.undistorted[static_cast<size_t>(l)]);
+      left_lines_of = l;
+    }
     const Eigen::Vector2d& ur = right.undistorted[static_cast<size_t>(r)];
-    const EpipolarMatcher::Lines lines = matcher_.lines(ul);
-    return std::abs(lines.nominal.dot(ur.homogeneous())) <= matcher_.bandHalfWidth(lines, ur);
+    return std::abs(left_lines.nominal.dot(ur.homogeneous())) <=
+           matcher_.bandHalfWidth(left_lines, ur);
   };
   // Sub-pixel right pixel of a pair: the left keypoint's patch aligned into the right image;
   // false if the alignment is unreliable (edge, occlusion, different content) or leaves the

@@ -31,6 +31,7 @@
 #include <cv_bridge/cv_bridge.h>
 #include <ros/package.h>
 #include <sensor_msgs/Image.h>
+#include <opencv2/core/utility.hpp>
 
 #include "bag_io.h"
 #include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
@@ -48,6 +49,7 @@ struct Options {
   std::string bag, out, initial_guess, config, reference, truth_topic;
   int window_first = -1, window_last = -1;
   int max_pairs = -1;  ///< stop after this many stereo pairs (-1: all)
+  int threads = 1;     ///< OpenCV's worker threads (cv::setNumThreads)
   /// Topics (interface.md: left/image_raw, ... relative to the stereo namespace, and odom).
   std::string stereo_ns = "/stereo";
   std::string left_image, right_image, left_info, right_info, odom = "/odom";
@@ -89,6 +91,10 @@ osc::CommandLine commandLine(Options* o) {
   cli.option("--frames", &o->max_pairs, "N", "evaluate only the first N stereo pairs")
       .range(1, 1e9)
       .defaultText("all");
+  // One by default: the speed figures (docs/benchmarks.md) are one core's, and a second
+  // thread inside OpenCV would make them look better than one core delivers.
+  cli.option("--threads", &o->threads, "N", "threads OpenCV may use (detection, filtering)")
+      .range(1, 256);
   return cli;
 }
 
@@ -162,6 +168,7 @@ std::string quote(const std::string& s) { return "'" + s + "'"; }
 
 /// The tool itself, after the command line.
 int evaluateBag(const Options& options) {
+  cv::setNumThreads(options.threads);
   osc::bag::DriveTopics topics;
   topics.left_image = options.left_image;
   topics.right_image = options.right_image;

@@ -13,6 +13,7 @@
 /// points marginalised. Memory and time O(N) instead of O(N^2) / O(N^3).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -120,6 +121,7 @@ class CalibrationFilter {
     Eigen::Matrix3d D = Eigen::Matrix3d::Zero();
   };
   struct PointInnovation;  // defined in the .cpp
+  struct Prediction;       // defined in the .cpp
 
   std::string checkMotion(const MotionIncrement& motion) const;
   /// One predict + update linearised at `motion` with the given prior mean of the motion
@@ -130,9 +132,15 @@ class CalibrationFilter {
                StepReport* report, Vector6d* motion_error);
   /// Drift, motion-error augmentation and point prediction; returns the global covariance
   /// (12, or 18 with the step's motion error) and marks points that could not be predicted.
-  Eigen::MatrixXd predict(const MotionIncrement& motion, std::vector<bool>* failed);
+  /// The prediction (drift, points) from the current state; remember: keep it in
+  /// last_prediction_ for a later predict() from the same state with the same motion.
+  Eigen::MatrixXd predict(const MotionIncrement& motion, std::vector<bool>* failed,
+                          bool remember = false);
+  Eigen::MatrixXd predictAnew(const MotionIncrement& motion, std::vector<bool>* failed);
+  /// remember: keep the point's UT in last_prediction_ for the step (predictObservations).
   bool linearizeMeasurement(size_t index, const Eigen::MatrixXd& P, const Eigen::Vector4d& z,
-                            const Eigen::Vector4d& variance, PointInnovation* innovation) const;
+                            const Eigen::Vector4d& variance, PointInnovation* innovation,
+                            bool remember = false) const;
   void applyCalibrationDrift(double dt);
   void predictPoints(const MotionIncrement& motion, const Eigen::MatrixXd& P_global,
                      std::vector<bool>* failed);
@@ -151,6 +159,10 @@ class CalibrationFilter {
   Matrix12d covariance_ = Matrix12d::Identity();
   std::vector<TrackedPoint> points_;
   std::unordered_map<PointId, size_t> index_;
+  /// The last predictObservations' prediction: the step that follows, with the same motion
+  /// from the same state, reuses it instead of repeating the per-point UTs (so neither
+  /// predictObservations nor step may run concurrently on one filter).
+  mutable std::shared_ptr<const Prediction> last_prediction_;
 };
 
 }  // namespace osc

@@ -19,6 +19,8 @@ class Feature2D;
 
 namespace osc {
 
+class OrbDescription;
+
 /// Converts a CV_8UC1, CV_16UC1 (scaled by its bit depth), CV_8UC3 (BGR) or CV_8UC4 (BGRA)
 /// image to mono8 and checks it: not empty, at least config.min_image_size, the size the
 /// intrinsics say, some contrast (not all black / saturated). Returns "" if usable, else a
@@ -31,12 +33,16 @@ class SpatialGrid {
  public:
   /// Indexes points (px) of an image of the given size with square cells.
   void build(const std::vector<Eigen::Vector2d>& points, int width, int height, double cell);
-  /// Appends to `out` the indices of points inside [min, max] (box, px).
+  /// Appends to `out` the indices of points inside [min, max] (box, px): cell by cell, row
+  /// by row, and in increasing index within a cell.
   void query(const Eigen::Vector2d& min, const Eigen::Vector2d& max, std::vector<int>* out) const;
 
  private:
-  std::vector<Eigen::Vector2d> points_;
-  std::vector<std::vector<int>> cells_;
+  // The points sorted by cell (row-major, stable): the cells of one grid row that a box
+  // covers are one contiguous range, scanned without indirection.
+  std::vector<int> cell_start_;                 ///< cols_ * rows_ + 1 offsets into the two below
+  std::vector<int> sorted_index_;               ///< point index, in cell order
+  std::vector<Eigen::Vector2d> sorted_points_;  ///< its position
   int cols_ = 0, rows_ = 0;
   double cell_ = 1.0;
 };
@@ -78,6 +84,8 @@ class FeatureDetector {
   FrontEndConfig config_;
   cv::Ptr<cv::Feature2D> detector_;
   cv::Ptr<cv::Feature2D> describer_;
+  /// ORB on one level: its descriptors computed by OrbDescription (the same bits, faster).
+  std::unique_ptr<OrbDescription> orb_description_;
 };
 
 }  // namespace osc
