@@ -104,14 +104,23 @@ DriveFigures drive(const MeasurementScenario& scenario, const FilterConfig& filt
 /// and >= 50 points alive. "Correct" is ImageFrameResult's: one scene point within 1.5 px of
 /// both pixels. The stricter figures at the exact left pixel are printed, not asserted: they
 /// also fail correct matches of outlines whose keypoint lies a pixel off the object.
-void expectGoodDrive(const DriveFigures& f, int frames, double track_precision = 0.99) {
+/// Where a case is below the targets, its bars are the measured figures minus a margin.
+struct DriveBars {
+  double matches_correct = 0.99;
+  double new_correct = 0.99;
+  int tracks_per_frame = 25;
+  double tracks_stereo_correct = 0.99;
+  double tracks_correct = 0.99;  ///< on their birth point
+};
+
+void expectGoodDrive(const DriveFigures& f, int frames, const DriveBars& bars = {}) {
   EXPECT_EQ(f.processed, frames);
   EXPECT_GE(f.matches, 100 * frames);
-  EXPECT_GE(f.matches_correct, 0.99 * f.matches);
-  EXPECT_GE(f.new_correct, 0.99 * f.new_points);
-  EXPECT_GE(f.tracks, 25 * frames);
-  EXPECT_GE(f.tracks_stereo_correct, 0.99 * f.tracks_reported);
-  EXPECT_GE(f.tracks_correct, track_precision * f.tracks);
+  EXPECT_GE(f.matches_correct, bars.matches_correct * f.matches);
+  EXPECT_GE(f.new_correct, bars.new_correct * f.new_points);
+  EXPECT_GE(f.tracks, bars.tracks_per_frame * frames);
+  EXPECT_GE(f.tracks_stereo_correct, bars.tracks_stereo_correct * f.tracks_reported);
+  EXPECT_GE(f.tracks_correct, bars.tracks_correct * f.tracks);
   EXPECT_GE(f.final_points, 50);
 }
 
@@ -164,14 +173,12 @@ TEST(FrontEnd, NoisyBlurredFlickeringImages) {
   negative_gain.exposure_variation = 1.2;
   EXPECT_THROW(runImageScenario(shortDrive(1), confidentConfig(), FrontEndConfig(), negative_gain),
                std::invalid_argument);
-  EXPECT_EQ(f.processed, frames);
-  EXPECT_GE(f.matches, 100 * frames);
-  EXPECT_GE(f.matches_correct, 0.99 * f.matches);
-  EXPECT_GE(f.new_correct, 0.98 * f.new_points);
-  EXPECT_GE(f.tracks, 20 * frames);
-  EXPECT_GE(f.tracks_stereo_correct, 0.92 * f.tracks_reported);
-  EXPECT_GE(f.tracks_correct, 0.91 * f.tracks);
-  EXPECT_GE(f.final_points, 50);
+  DriveBars bars;
+  bars.new_correct = 0.98;
+  bars.tracks_per_frame = 20;
+  bars.tracks_stereo_correct = 0.92;
+  bars.tracks_correct = 0.91;
+  expectGoodDrive(f, frames, bars);
 }
 
 TEST(FrontEnd, SearchingLostTracksKeepsMoreTracksAtTheSameStereoPrecision) {
@@ -208,7 +215,9 @@ TEST(FrontEnd, EquidistantDistortedRawImages) {
   // NOT AT TARGET: tracks on their birth point 98.35 % (40 frames; the rest >= 99.4 %). The
   // misses are outlines of far objects against the backdrop that slide along the outline as
   // the view changes (a consistent pair every frame, but not one surface point).
-  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), frames, 0.98);
+  DriveBars bars;
+  bars.tracks_correct = 0.98;
+  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), frames, bars);
 }
 
 TEST(FrontEnd, WrongCalibrationBandStillFindsCorrectMatches) {

@@ -35,10 +35,10 @@ StereoObservation observation(PointId id, const Eigen::Vector2d& left,
   return o;
 }
 
-/// The template scale of a track's temporal alignment: the predicted growth of its patch,
-/// bounded so that a badly estimated point cannot ask for an absurd resampling.
-double templateScale(const TrackWindow& w) {
-  return std::isfinite(w.scale) ? std::clamp(w.scale, 0.5, 2.0) : 1.0;
+/// A predicted growth of a patch as a template scale, bounded so that a badly estimated
+/// point cannot ask for an absurd resampling (the anchor's crop allows down to 0.5).
+double templateScale(double growth) {
+  return std::isfinite(growth) ? std::clamp(growth, 0.5, 2.0) : 1.0;
 }
 
 /// The anchor of a new point: a crop of its left image around the pixel, wide enough for its
@@ -158,7 +158,7 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     if (config_.max_anchor_shift <= 0.0 || anchor == nullptr) return true;
     PatchAlignmentConfig c = alignment;
     c.max_shift = config_.max_anchor_shift;
-    c.template_scale = std::clamp(anchor->scale, 0.5, 2.0);
+    c.template_scale = templateScale(anchor->scale);
     const PatchAlignment a = alignPatch(anchor->crop, anchor->pixel, left_mono, *left_raw, c);
     if (!a.ok) return false;
     *left_raw = a.position;
@@ -194,8 +194,8 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     temporal.max_shift = config_.max_temporal_shift;
     std::unordered_map<PointId, double> scale_of;
     for (const TrackWindow& w : last_windows_) {
-      scale_of[w.id] = templateScale(w);
-      tracker_.growAnchor(w.id, templateScale(w));
+      scale_of[w.id] = templateScale(w.scale);
+      tracker_.growAnchor(w.id, scale_of[w.id]);
     }
     const auto scaleOf = [&](PointId id) {
       const auto it = scale_of.find(id);
@@ -240,7 +240,7 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
       PatchAlignmentConfig search = alignment;
       search.max_shift = w.left_half.maxCoeff();
       search.min_ncc = config_.min_search_ncc;
-      search.template_scale = templateScale(w);
+      search.template_scale = templateScale(w.scale);
       const PatchAlignment a =
           alignPatch(previous_left_, previous, left_mono, w.left_center, search);
       if (!a.ok) continue;
