@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -140,6 +141,26 @@ TEST(FrontEndConfig, DefaultsAreValidAndProblemsAreNamed) {
                std::invalid_argument);
 }
 
+TEST(CornerNear, MovesAKeypointBesideAJunctionOntoIt) {
+  // A T-junction: a horizontal edge (dark above, light below) ends at a dark post whose left
+  // outline runs at x = 29.5; the junction is at (29.5, 29.5). A keypoint 2.1 px beside it
+  // moves onto it (to 0.8 px: the mixed gradients right at the junction pull it along the
+  // post's outline; within the 1.5 px of a correct match, where the keypoint was not).
+  cv::Mat image(60, 60, CV_8UC1, cv::Scalar(180));
+  image(cv::Rect(0, 0, 30, 30)).setTo(60);
+  image(cv::Rect(30, 0, 30, 60)).setTo(10);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 0.7);
+  const Eigen::Vector2d junction(29.5, 29.5);
+  Eigen::Vector2d corner(-1.0, -1.0);
+  ASSERT_TRUE(cornerNear(image, Eigen::Vector2d(28.0, 31.0), 2, 2.0, &corner));
+  EXPECT_NEAR(corner.x(), junction.x(), 0.2) << corner.transpose();
+  EXPECT_LT((corner - junction).norm(), 1.0) << corner.transpose();
+  // Farther than max_shift: refused, the output untouched.
+  Eigen::Vector2d untouched(-1.0, -1.0);
+  EXPECT_FALSE(cornerNear(image, Eigen::Vector2d(28.0, 31.0), 2, 1.0, &untouched));
+  EXPECT_EQ(untouched, Eigen::Vector2d(-1.0, -1.0));
+}
+
 TEST(Bucketing, KeepsTheBestPerFreeCellUpToTheCap) {
   const std::vector<Eigen::Vector2d> pos = {{10, 10}, {20, 20}, {150, 10}, {10, 150}, {150, 150}};
   const std::vector<double> cost = {0.3, 0.1, 0.2, 0.05, 0.4};
@@ -158,11 +179,12 @@ TEST(FrontEnd, MatchesAndTracksAreCorrectOnRenderedDrive) {
 TEST(FrontEnd, NoisyBlurredFlickeringImages) {
   // A poorer camera than the bags' (1 grey level, 0.5 px): sensor noise of 3 grey levels,
   // 0.8 px optical blur, and auto-exposure flicker of +-10 % per image, independently left
-  // and right. Measured (20 frames): stereo matches 99.80 % correct, new points 98.99 %,
-  // tracks 94.25 % stereo-correct and 93.36 % on their birth point, 61 points alive.
+  // and right. Measured (20 frames): stereo matches 99.75 % correct, new points 99.37 %,
+  // tracks 98.62 % stereo-correct and 97.84 % on their birth point, 58 points alive.
   // NOT AT TARGET: tracks (99 % wanted). The wrong ones are keypoints the noise makes in the
   // sky a few pixels off an object's outline: the patch is the outline's, so the pair is
   // consistent every frame with the object's disparity but the pixel is 2-6 px off it.
+  // (Before new points were moved to their sub-pixel corner: 94.2 % and 93.3 %.)
   const int frames = 20;
   ImageScenarioOptions poor;
   poor.render.noise_sigma = 3.0;
@@ -174,16 +196,15 @@ TEST(FrontEnd, NoisyBlurredFlickeringImages) {
   EXPECT_THROW(runImageScenario(shortDrive(1), confidentConfig(), FrontEndConfig(), negative_gain),
                std::invalid_argument);
   DriveBars bars;
-  bars.new_correct = 0.98;
   bars.tracks_per_frame = 20;
-  bars.tracks_stereo_correct = 0.92;
-  bars.tracks_correct = 0.91;
+  bars.tracks_stereo_correct = 0.98;
+  bars.tracks_correct = 0.97;
   expectGoodDrive(f, frames, bars);
 }
 
 TEST(FrontEnd, SearchingLostTracksKeepsMoreTracksAtTheSameStereoPrecision) {
-  // Off by default: measured (20 frames) 1206 tracks instead of 604, 99.92 % stereo-correct
-  // and 99.50 % on their birth point (with the anchor check; 92.2 % before it: LK from the
+  // Off by default: measured (20 frames) 1228 tracks instead of 534, 100 % stereo-correct
+  // and 99.43 % on their birth point (with the anchor check; 92.2 % before it: LK from the
   // prediction let tracks on the near ground drift). Not yet measured on the full drives.
   const int frames = 20;
   FrontEndConfig with_search;
@@ -212,12 +233,10 @@ TEST(FrontEnd, EquidistantDistortedRawImages) {
     k->model = DistortionModel::kEquidistant;
     k->distortion = {-0.01, 0.005, -0.002, 0.0};
   }
-  // NOT AT TARGET: tracks on their birth point 98.35 % (40 frames; the rest >= 99.4 %). The
-  // misses are outlines of far objects against the backdrop that slide along the outline as
-  // the view changes (a consistent pair every frame, but not one surface point).
-  DriveBars bars;
-  bars.tracks_correct = 0.98;
-  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), frames, bars);
+  // Measured: tracks on their birth point 99.49 % (98.41 % without FrontEndConfig's
+  // corner_half_size: keypoints beside a junction of a near outline with a far surface were
+  // carried along the outline), the rest >= 99.7 %.
+  expectGoodDrive(drive(s, confidentConfig(), FrontEndConfig()), frames);
 }
 
 TEST(FrontEnd, WrongCalibrationBandStillFindsCorrectMatches) {
@@ -273,38 +292,62 @@ TEST(PatchAlignment, RecoversASubPixelShiftAndBrightnessOffset) {
       alignPatch(source, Eigen::Vector2d(40, 50), target, Eigen::Vector2d(40, 50), config).ok);
 }
 
-TEST(PatchAlignment, ResampledTemplateFollowsAnApproachingSurface) {
-  // target(x) = source((x - c) / s + c): the surface around c appears s times larger, as a
-  // point approached by the camera. The point p (off the centre c) moves to c + s (p - c).
-  const double s = 1.3;
+/// Aligns patches of a texture into the texture warped by the linear map A about a centre
+/// c (target(c + A (x - c)) = source(x)), from a guess 0.6 px off, once with the template
+/// resampled for A (template_sampling = A^-1) and once plain. Mean errors and NCCs.
+struct WarpedAlignment {
+  double error_fitted = 0.0, error_plain = 0.0, ncc_fitted = 0.0, ncc_plain = 0.0;
+};
+
+WarpedAlignment alignUnderWarp(const Eigen::Matrix2d& A) {
   const Eigen::Vector2d c(60, 50);
   const cv::Mat source = texture(120, 100, 7);
-  const cv::Mat M = (cv::Mat_<double>(2, 3) << s, 0, (1 - s) * c.x(), 0, s, (1 - s) * c.y());
+  const Eigen::Vector2d t = c - A * c;
+  const cv::Mat M = (cv::Mat_<double>(2, 3) << A(0, 0), A(0, 1), t.x(), A(1, 0), A(1, 1), t.y());
   cv::Mat target;
   cv::warpAffine(source, target, M, source.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
   PatchAlignmentConfig config;
   config.min_ncc = 0.0;  // compare positions, not the NCC check
   config.max_shift = 5.0;
-  double error_scaled = 0.0, error_plain = 0.0, ncc_scaled = 0.0, ncc_plain = 0.0;
+  WarpedAlignment w;
   const std::vector<Eigen::Vector2d> points = {{52, 44}, {66.5, 55.2}, {57, 58}, {70, 41}};
   for (const Eigen::Vector2d& p : points) {
-    const Eigen::Vector2d truth = c + s * (p - c);
+    const Eigen::Vector2d truth = c + A * (p - c);
     const Eigen::Vector2d guess = (truth.array() + 0.6).matrix();
-    config.template_scale = s;
-    const PatchAlignment scaled = alignPatch(source, p, target, guess, config);
-    config.template_scale = 1.0;
+    config.template_sampling = A.inverse();
+    const PatchAlignment fitted = alignPatch(source, p, target, guess, config);
+    config.template_sampling = Eigen::Matrix2d::Identity();
     const PatchAlignment plain = alignPatch(source, p, target, guess, config);
-    error_scaled += (scaled.position - truth).norm() / points.size();
-    error_plain += (plain.position - truth).norm() / points.size();
-    ncc_scaled += scaled.ncc / points.size();
-    ncc_plain += plain.ncc / points.size();
+    w.error_fitted += (fitted.position - truth).norm() / points.size();
+    w.error_plain += (plain.position - truth).norm() / points.size();
+    w.ncc_fitted += fitted.ncc / points.size();
+    w.ncc_plain += plain.ncc / points.size();
   }
-  EXPECT_LT(error_scaled, 0.1);
-  EXPECT_GT(ncc_scaled, 0.98);
-  EXPECT_GT(ncc_scaled, ncc_plain + 0.02);  // the unscaled template fits the surface worse
-  EXPECT_GT(error_plain, 3.0 * error_scaled);
-  std::printf("  mean error resampled %.3f px (NCC %.3f), unscaled %.3f px (NCC %.3f)\n",
-              error_scaled, ncc_scaled, error_plain, ncc_plain);
+  std::printf("  mean error resampled %.3f px (NCC %.3f), plain %.3f px (NCC %.3f)\n",
+              w.error_fitted, w.ncc_fitted, w.error_plain, w.ncc_plain);
+  return w;
+}
+
+TEST(PatchAlignment, ResampledTemplateFollowsAnApproachingSurface) {
+  // The surface appears 1.3 times larger, as a point approached by the camera.
+  const WarpedAlignment w = alignUnderWarp(1.3 * Eigen::Matrix2d::Identity());
+  EXPECT_LT(w.error_fitted, 0.1);
+  EXPECT_GT(w.ncc_fitted, 0.98);
+  EXPECT_GT(w.ncc_fitted, w.ncc_plain + 0.02);  // the plain template fits the surface worse
+  EXPECT_GT(w.error_plain, 3.0 * w.error_fitted);
+}
+
+TEST(PatchAlignment, ResampledTemplateFollowsALensSqueeze) {
+  // A fisheye lens squeezes a patch moving outwards along the radius (here at 30 deg to the
+  // x axis) more than across it (CameraModel::lensJacobian; the front end's templateSampling).
+  const double angle = M_PI / 6.0;
+  const Eigen::Matrix2d R = Eigen::Rotation2Dd(angle).toRotationMatrix();
+  const Eigen::Matrix2d A = R * Eigen::Vector2d(0.8, 0.95).asDiagonal() * R.transpose();
+  const WarpedAlignment w = alignUnderWarp(A);
+  EXPECT_LT(w.error_fitted, 0.1);
+  EXPECT_GT(w.ncc_fitted, 0.98);
+  EXPECT_GT(w.ncc_fitted, w.ncc_plain + 0.02);
+  EXPECT_GT(w.error_plain, 3.0 * w.error_fitted);
 }
 
 TEST(PatchAlignment, RefusesStraightEdgesAndDifferentContent) {
@@ -550,6 +593,15 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
       k->model = equidistant ? DistortionModel::kEquidistant : DistortionModel::kPlumbBob;
       k->distortion = equidistant ? std::vector<double>{-0.01, 0.005, -0.002, 0.0}
                                   : std::vector<double>{-0.28, 0.074, 0.0002, 0.00002, 0.0};
+      if (std::getenv("D_K")) {  // comma-separated distortion coefficients
+        k->distortion.clear();
+        std::string list = std::getenv("D_K");
+        for (size_t at = 0; at < list.size();) {
+          const size_t end = std::min(list.find(',', at), list.size());
+          k->distortion.push_back(std::atof(list.substr(at, end - at).c_str()));
+          at = end + 1;
+        }
+      }
     }
   }
   MeasurementSimulator sim(s);
@@ -585,6 +637,7 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
   envd("D_FB", &fe.max_forward_backward);
   envd("D_EIG", &fe.min_patch_eigen_ratio);
   envd("D_ANCHOR", &fe.max_anchor_shift);
+  envd("D_TSHIFT", &fe.max_temporal_shift);
   envd("D_MAXD", &fe.max_descriptor_distance);
   envd("D_TMAXD", &fe.max_track_descriptor_distance);
   envi("D_HALF", &fe.patch_half_size);
@@ -680,7 +733,7 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
         for (const auto& o : pipeline.frontEnd().lastStereoMatches())
           diagPair(c, "M", o.left_pixel, o.right_pixel, false);
         for (const auto& o : pipeline.frontEnd().lastTracked())
-          diagPair(c, "T", o.left_pixel, o.right_pixel, false);
+          diagPair(c, ("T " + std::to_string(o.id)).c_str(), o.left_pixel, o.right_pixel, false);
       });
   std::printf(
       "SUMMARY matches %d (%.2f %%) new %d (%.2f %%) tracks %d (stereo %.2f %%, birth %.2f %% of "

@@ -858,6 +858,40 @@ TEST(CameraModel, EquidistantDistortionIsTheKannalaBrandtPolynomial) {
   EXPECT_TRUE(matrixNear(camera.distort(n), n * theta_d / r, 1e-15));
 }
 
+TEST(CameraModel, LensJacobianIsTheEquidistantLensStretch) {
+  // A pure equidistant lens (r_raw = f theta, r_pinhole = f tan theta): offsets along the
+  // radius shrink by d theta / d tan theta = cos^2 theta, across it by theta / tan theta.
+  CameraIntrinsics in;
+  in.width = 640;
+  in.height = 480;
+  in.fx = in.fy = 600.0;
+  in.cx = 319.5;
+  in.cy = 239.5;
+  in.model = DistortionModel::kEquidistant;
+  in.distortion = {1e-12, 0.0, 0.0, 0.0};  // all zero would be a plain pinhole
+  const CameraModel camera(in);
+  const double n = 0.5, theta = std::atan(n);
+  const double radial = 1.0 / (1.0 + n * n), across = theta / n;
+  const Eigen::Matrix2d on_x = camera.lensJacobian(Eigen::Vector2d(in.cx + 600.0 * n, in.cy));
+  const Eigen::Matrix2d on_y = camera.lensJacobian(Eigen::Vector2d(in.cx, in.cy - 600.0 * n));
+  EXPECT_TRUE(matrixNear(on_x, Eigen::Vector2d(radial, across).asDiagonal().toDenseMatrix(), 1e-4))
+      << on_x;
+  EXPECT_TRUE(matrixNear(on_y, Eigen::Vector2d(across, radial).asDiagonal().toDenseMatrix(), 1e-4))
+      << on_y;
+  // Any lens: the Jacobian predicts where a small offset lands in the raw image.
+  const CameraModel euroc(eurocCam0());
+  const Eigen::Vector2d u(600.0, 50.0), du(0.3, -0.2);
+  const auto toRaw = [&](const Eigen::Vector2d& x) {
+    const CameraIntrinsics& k = euroc.intrinsics();
+    return euroc.normalizedToPixel(Eigen::Vector2d((x.x() - k.cx) / k.fx, (x.y() - k.cy) / k.fy));
+  };
+  EXPECT_TRUE(matrixNear(toRaw(u + du) - toRaw(u), euroc.lensJacobian(u) * du, 1e-3));
+  // Without distortion it is exactly the identity.
+  CameraIntrinsics none = in;
+  none.distortion = {0.0, 0.0, 0.0, 0.0};
+  EXPECT_TRUE(matrixNear(CameraModel(none).lensJacobian(u), Eigen::Matrix2d::Identity(), 0.0));
+}
+
 std::string constructionError(const CameraIntrinsics& in) {
   try {
     CameraModel camera(in);

@@ -937,6 +937,8 @@ TEST(FrontEndParameterTable, CoversEveryFieldOnce) {
                                            "max_new_points_per_frame",
                                            "min_distance_to_track",
                                            "min_parallax_deg",
+                                           "corner_half_size",
+                                           "max_corner_shift",
                                            "track_window_sigmas",
                                            "min_track_window",
                                            "max_track_window",

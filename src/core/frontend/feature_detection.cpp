@@ -132,8 +132,19 @@ void SpatialGrid::query(const Eigen::Vector2d& min, const Eigen::Vector2d& max,
 #define OSC_WITH_POPCNT_CLONE
 #endif
 
-OSC_WITH_POPCNT_CLONE double hammingDistance(const unsigned char* a, const unsigned char* b,
-                                             int bytes) {
+OSC_WITH_POPCNT_CLONE bool cornerNear(const cv::Mat& image, const Eigen::Vector2d& pixel,
+                                      int half_size, double max_shift, Eigen::Vector2d* corner) {
+  std::vector<cv::Point2f> at = {
+      cv::Point2f(static_cast<float>(pixel.x()), static_cast<float>(pixel.y()))};
+  cv::cornerSubPix(image, at, cv::Size(half_size, half_size), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01));
+  const Eigen::Vector2d found(at[0].x, at[0].y);
+  if (!found.allFinite() || (found - pixel).norm() > max_shift) return false;
+  *corner = found;
+  return true;
+}
+
+double hammingDistance(const unsigned char* a, const unsigned char* b, int bytes) {
   int bits = 0;
   int k = 0;
   for (; k + 8 <= bytes; k += 8) {

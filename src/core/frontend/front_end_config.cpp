@@ -248,6 +248,13 @@ const std::vector<FrontEndParameterSpec>& frontEndParameterTable() {
            "no new point within this distance (px, left image) of a tracked one"),
       real("min_parallax_deg", &C::min_parallax_deg, 0.0, 30.0, kClosed,
            "least angle between the two rays of a new point (deg)"),
+      integer("corner_half_size", &C::corner_half_size, 0, 15,
+              "new points: half-size (px) of the window in which the left keypoint is moved to "
+              "its sub-pixel corner (cv::cornerSubPix) before the right pixel is aligned again "
+              "(0 = off)"),
+      real("max_corner_shift", &C::max_corner_shift, 0.0, 20.0, kOpen,
+           "new points: a corner farther (px) than this from the keypoint is not taken (the "
+           "pair stays as matched)"),
       // --- tracking (Sec. II-C) ---
       real("track_window_sigmas", &C::track_window_sigmas, 0.0, 10.0, kOpen,
            "track search window half-size in sigmas of the predicted pixel"),

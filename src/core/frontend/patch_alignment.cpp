@@ -57,28 +57,28 @@ bool samplePatch(const cv::Mat& image, const Eigen::Vector2d& p, int h, std::vec
   return true;
 }
 
-/// Samples the (2h+1)^2 patch centred at p with `spacing` px between samples (bilinear,
-/// weights per sample). False if any sample falls outside the image.
-bool sampleScaledPatch(const cv::Mat& image, const Eigen::Vector2d& p, int h, double spacing,
-                       std::vector<float>* out) {
+/// Samples the (2h+1)^2 patch centred at p whose sample (x, y) lies at p + M (x, y)
+/// (bilinear, weights per sample). False if any sample falls outside the image.
+bool sampleWarpedPatch(const cv::Mat& image, const Eigen::Vector2d& p, int h,
+                       const Eigen::Matrix2d& M, std::vector<float>* out) {
   const int n = 2 * h + 1;
   out->resize(static_cast<size_t>(n * n));
-  const double reach = h * spacing;
-  if (!(p.x() - reach >= 0.0 && p.y() - reach >= 0.0 && p.x() + reach <= image.cols - 1.0 &&
-        p.y() + reach <= image.rows - 1.0)) {
+  const double reach_x = h * (std::abs(M(0, 0)) + std::abs(M(0, 1)));
+  const double reach_y = h * (std::abs(M(1, 0)) + std::abs(M(1, 1)));
+  if (!(p.x() - reach_x >= 0.0 && p.y() - reach_y >= 0.0 && p.x() + reach_x <= image.cols - 1.0 &&
+        p.y() + reach_y <= image.rows - 1.0)) {
     return false;
   }
   float* o = out->data();
   for (int y = -h; y <= h; ++y) {
-    const double sy = p.y() + y * spacing;
-    const int y0 = std::min(static_cast<int>(sy), image.rows - 2);
-    const float ay = static_cast<float>(sy - y0);
-    const unsigned char* r0 = image.ptr<unsigned char>(y0);
-    const unsigned char* r1 = r0 + image.step[0];
     for (int x = -h; x <= h; ++x) {
-      const double sx = p.x() + x * spacing;
+      const double sx = p.x() + (x * M(0, 0) + y * M(0, 1));
+      const double sy = p.y() + (y * M(1, 1) + x * M(1, 0));
       const int x0 = std::min(static_cast<int>(sx), image.cols - 2);
-      const float ax = static_cast<float>(sx - x0);
+      const int y0 = std::min(static_cast<int>(sy), image.rows - 2);
+      const float ax = static_cast<float>(sx - x0), ay = static_cast<float>(sy - y0);
+      const unsigned char* r0 = image.ptr<unsigned char>(y0);
+      const unsigned char* r1 = r0 + image.step[0];
       *o++ = (1.0f - ay) * ((1.0f - ax) * r0[x0] + ax * r0[x0 + 1]) +
              ay * ((1.0f - ax) * r1[x0] + ax * r1[x0 + 1]);
     }
@@ -99,9 +99,9 @@ PatchAlignment alignPatch(const cv::Mat& source, const Eigen::Vector2d& source_p
   // Scratch buffers reused across calls (one set per thread).
   thread_local std::vector<float> big, tmpl, gx, gy, warped;
   const bool sampled =
-      config.template_scale == 1.0
+      config.template_sampling == Eigen::Matrix2d::Identity()
           ? samplePatch(source, source_point, h + 1, &big)
-          : sampleScaledPatch(source, source_point, h + 1, 1.0 / config.template_scale, &big);
+          : sampleWarpedPatch(source, source_point, h + 1, config.template_sampling, &big);
   if (!sampled) return result;
   const int nb = n + 2;
   tmpl.resize(static_cast<size_t>(n * n));

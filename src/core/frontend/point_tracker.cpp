@@ -18,18 +18,12 @@ Eigen::Vector2d toRaw(const CameraModel& camera, const Eigen::Vector2d& undistor
   return camera.normalizedToPixel(normalized);
 }
 
-/// Window of one image: S (undistorted px^2) mapped to raw pixels through the numerical
-/// Jacobian of the distortion.
+/// Window of one image: S (undistorted px^2) mapped to raw pixels through the lens's
+/// Jacobian.
 void window(const CameraModel& camera, const Eigen::Vector2d& z, const Eigen::Matrix2d& S,
             const FrontEndConfig& config, Eigen::Vector2d* center, Eigen::Vector2d* half) {
   *center = toRaw(camera, z);
-  Eigen::Matrix2d J;
-  const double h = 0.5;
-  for (int k = 0; k < 2; ++k) {
-    Eigen::Vector2d dz = Eigen::Vector2d::Zero();
-    dz(k) = h;
-    J.col(k) = (toRaw(camera, z + dz) - toRaw(camera, z - dz)) / (2.0 * h);
-  }
+  const Eigen::Matrix2d J = camera.lensJacobian(z);
   const Eigen::Matrix2d S_raw = J * S * J.transpose();
   for (int k = 0; k < 2; ++k) {
     const double sigma = std::sqrt(std::max(0.0, S_raw(k, k)));

@@ -41,6 +41,16 @@ double templateScale(double growth) {
   return std::isfinite(growth) ? std::clamp(growth, 0.5, 2.0) : 1.0;
 }
 
+/// PatchAlignmentConfig::template_sampling for a patch seen at raw pixel `from` and looked
+/// for at raw pixel `to` of the same camera, grown by `growth` in between: a step in the target
+/// is undone by the lens's stretch at `to`, shrunk by the growth, and stretched by the lens at
+/// `from` (under a distorted lens a patch also changes shape as it crosses the image).
+Eigen::Matrix2d templateSampling(const CameraModel& camera, const Eigen::Vector2d& from,
+                                 const Eigen::Vector2d& to, double growth) {
+  return camera.lensJacobian(camera.undistortPixel(from)) * (1.0 / templateScale(growth)) *
+         camera.lensJacobian(camera.undistortPixel(to)).inverse();
+}
+
 /// The anchor of a new point: a crop of its left image around the pixel, wide enough for its
 /// patch resampled at half the size (radius 2 (half_size + 1) + 1), clipped at the border.
 TrackAnchor makeAnchor(const cv::Mat& image, const Eigen::Vector2d& pixel, int half_size) {
@@ -53,6 +63,7 @@ TrackAnchor makeAnchor(const cv::Mat& image, const Eigen::Vector2d& pixel, int h
   if (inside.area() == 0) return anchor;
   anchor.crop = image(inside).clone();
   anchor.pixel = pixel - Eigen::Vector2d(inside.x, inside.y);
+  anchor.image_pixel = pixel;
   return anchor;
 }
 
@@ -158,16 +169,17 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     if (config_.max_anchor_shift <= 0.0 || anchor == nullptr) return true;
     PatchAlignmentConfig c = alignment;
     c.max_shift = config_.max_anchor_shift;
-    c.template_scale = templateScale(anchor->scale);
+    c.template_sampling =
+        templateSampling(left_camera_, anchor->image_pixel, *left_raw, anchor->scale);
     const PatchAlignment a = alignPatch(anchor->crop, anchor->pixel, left_mono, *left_raw, c);
     if (!a.ok) return false;
     *left_raw = a.position;
     return true;
   };
 
-  // The anchor is only resampled in scale; a surface seen obliquely (the ground) also shears
-  // and foreshortens as it nears, so once its patch has grown or shrunk by more than
-  // kMaxAnchorGrowth the anchor is taken anew from this image (a small, rare restart of drift
+  // The anchor is only resampled in scale (and the lens's stretch); a surface seen obliquely (the
+  // ground) also shears and foreshortens as it nears, so once its patch has grown or shrunk by more
+  // than kMaxAnchorGrowth the anchor is taken anew from this image (a small, rare restart of drift
   // instead of a biased alignment).
   auto reanchorIfDeformed = [&](PointId id, const Eigen::Vector2d& left_raw) {
     constexpr double kMaxAnchorGrowth = 1.25;
@@ -206,7 +218,8 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
       Eigen::Vector2d left_und = left.undistorted[static_cast<size_t>(m.left)];
       Eigen::Vector2d previous;
       if (!previous_left_.empty() && tracker_.leftPixel(m.id, &previous)) {
-        temporal.template_scale = scaleOf(m.id);
+        temporal.template_sampling =
+            templateSampling(left_camera_, previous, left_raw, scaleOf(m.id));
         const PatchAlignment a =
             alignPatch(previous_left_, previous, left_mono, left_raw, temporal);
         if (!a.ok) continue;
@@ -240,13 +253,14 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
       PatchAlignmentConfig search = alignment;
       search.max_shift = w.left_half.maxCoeff();
       search.min_ncc = config_.min_search_ncc;
-      search.template_scale = templateScale(w.scale);
+      search.template_sampling = templateSampling(left_camera_, previous, w.left_center, w.scale);
       const PatchAlignment a =
           alignPatch(previous_left_, previous, left_mono, w.left_center, search);
       if (!a.ok) continue;
       // Forward-backward: the found patch aligned back must land where the point was.
       PatchAlignmentConfig backward = search;
-      backward.template_scale = 1.0 / search.template_scale;
+      backward.template_sampling =
+          templateSampling(left_camera_, a.position, previous, 1.0 / templateScale(w.scale));
       const PatchAlignment back =
           alignPatch(left_mono, a.position, previous_left_, previous, backward);
       if (!back.ok || (back.position - previous).norm() > config_.max_forward_backward) continue;
@@ -360,27 +374,40 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   const std::vector<int> kept =
       selectByBuckets(positions, costs, tracked_pixels, left_mono.cols, left_mono.rows,
                       config_.bucket_cols, config_.bucket_rows, max_new);
+  // A new pair's left keypoint moved to its sub-pixel corner, and the right pixel aligned
+  // again from there (FrontEndConfig::corner_half_size); the pair stays as matched where the
+  // corner lies too far or the right pixel does not align from it.
+  auto moveToCorner = [&](Eigen::Vector2d* left_raw, Eigen::Vector2d* right_raw) {
+    Eigen::Vector2d at;
+    if (config_.corner_half_size <= 0 || !cornerNear(left_mono, *left_raw, config_.corner_half_size,
+                                                     config_.max_corner_shift, &at)) {
+      return;
+    }
+    const Eigen::Vector2d left_und = left_camera_.undistortPixel(at);
+    Eigen::Vector2d right_at, right_und;
+    if (!refine(at, left_und, *right_raw, &right_at, &right_und) ||
+        !plausible(left_und, right_und)) {
+      return;
+    }
+    *left_raw = at;
+    *right_raw = right_at;
+  };
   for (int u : kept) {
     const StereoMatch& m = matches[static_cast<size_t>(usable[static_cast<size_t>(u)])];
-    if (!continuous(positions[static_cast<size_t>(u)],
-                    left.undistorted[static_cast<size_t>(m.left)],
-                    right_positions[static_cast<size_t>(u)],
-                    right_camera_.undistortPixel(right_positions[static_cast<size_t>(u)]))) {
-      continue;
-    }
+    Eigen::Vector2d left_raw = positions[static_cast<size_t>(u)];
+    Eigen::Vector2d right_raw = right_positions[static_cast<size_t>(u)];
+    moveToCorner(&left_raw, &right_raw);
+    const Eigen::Vector2d left_und = left_camera_.undistortPixel(left_raw);
+    const Eigen::Vector2d right_und = right_camera_.undistortPixel(right_raw);
+    if (!continuous(left_raw, left_und, right_raw, right_und)) continue;
     const PointId id = next_id_++;
-    observations.push_back(observation(id, positions[static_cast<size_t>(u)],
-                                       right_positions[static_cast<size_t>(u)]));
+    observations.push_back(observation(id, left_raw, right_raw));
     last_new_.push_back(observations.back());
-    last_bands_.push_back(
-        bandPolylines(left.undistorted[static_cast<size_t>(m.left)],
-                      right_camera_.undistortPixel(right_positions[static_cast<size_t>(u)])));
+    last_bands_.push_back(bandPolylines(left_und, right_und));
     pending_.push_back(
-        {id, left.descriptors.row(m.left).clone(), right.descriptors.row(m.right).clone(),
-         positions[static_cast<size_t>(u)],
-         config_.max_anchor_shift > 0.0
-             ? makeAnchor(left_mono, positions[static_cast<size_t>(u)], config_.patch_half_size)
-             : TrackAnchor()});
+        {id, left.descriptors.row(m.left).clone(), right.descriptors.row(m.right).clone(), left_raw,
+         config_.max_anchor_shift > 0.0 ? makeAnchor(left_mono, left_raw, config_.patch_half_size)
+                                        : TrackAnchor()});
   }
   stats.new_candidates = static_cast<int>(last_new_.size());
   if (statistics) *statistics = stats;

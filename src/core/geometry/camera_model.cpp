@@ -214,6 +214,22 @@ Eigen::Vector2d CameraModel::normalizedToPixel(const Eigen::Vector2d& normalized
                          intrinsics_.fy * d.y() + intrinsics_.cy);
 }
 
+Eigen::Matrix2d CameraModel::lensJacobian(const Eigen::Vector2d& undistorted_pixel) const {
+  if (intrinsics_.model == DistortionModel::kNone) return Eigen::Matrix2d::Identity();
+  const auto toRaw = [this](const Eigen::Vector2d& u) {
+    return normalizedToPixel(Eigen::Vector2d((u.x() - intrinsics_.cx) / intrinsics_.fx,
+                                             (u.y() - intrinsics_.cy) / intrinsics_.fy));
+  };
+  Eigen::Matrix2d jacobian;
+  const double h = 0.5;
+  for (int k = 0; k < 2; ++k) {
+    Eigen::Vector2d du = Eigen::Vector2d::Zero();
+    du(k) = h;
+    jacobian.col(k) = (toRaw(undistorted_pixel + du) - toRaw(undistorted_pixel - du)) / (2.0 * h);
+  }
+  return jacobian;
+}
+
 Eigen::Vector2d CameraModel::pixelToNormalized(const Eigen::Vector2d& pixel) const {
   const Eigen::Vector2d d((pixel.x() - intrinsics_.cx) / intrinsics_.fx,
                           (pixel.y() - intrinsics_.cy) / intrinsics_.fy);

@@ -50,6 +50,13 @@ class SpatialGrid {
 /// Number of differing bits between two binary descriptors of `bytes` bytes.
 double hammingDistance(const unsigned char* a, const unsigned char* b, int bytes);
 
+/// The sub-pixel corner near a keypoint `pixel` of a mono8 image: cv::cornerSubPix over a
+/// (2 half_size + 1)^2 window, the point where the window's gradients meet (e.g. the junction
+/// of two outlines, not a detector's pixel beside it). False, *corner untouched, if it lies
+/// farther than `max_shift` px from `pixel` or is not finite.
+bool cornerNear(const cv::Mat& image, const Eigen::Vector2d& pixel, int half_size, double max_shift,
+                Eigen::Vector2d* corner);
+
 /// The keypoints of one image with their descriptors, raw and undistorted positions.
 struct FeatureSet {
   std::vector<Eigen::Vector2d> raw;          ///< raw (distorted) pixel positions

@@ -93,6 +93,14 @@ struct FrontEndConfig {
   double min_distance_to_track = 10.0;
   /// Least angle between the two rays of a new point (deg), [0, 30].
   double min_parallax_deg = 0.05;
+  /// A new point's left keypoint is moved to its sub-pixel corner (cv::cornerSubPix over a
+  /// (2 corner_half_size + 1)^2 window: where the patch's gradients meet) and its right pixel
+  /// aligned again from there. A detector's pixel beside a junction of two outlines would
+  /// otherwise be carried along by them as they slide over each other. [0, 15]; 0 = off.
+  int corner_half_size = 2;
+  /// ... unless the corner lies farther (px) than this from the keypoint: the pair is then
+  /// kept as matched. (0, 20].
+  double max_corner_shift = 2.0;
 
   // --- tracking (Sec. II-C) ---
   /// Search window half-size in sigmas of the predicted pixel (from S), (0, 10].

@@ -18,10 +18,13 @@ struct PatchAlignmentConfig {
   double max_shift = 2.0;        ///< largest move from the initial guess
   double min_ncc = 0.9;          ///< least normalised cross-correlation after alignment
   double min_eigenvalue = 0.05;  ///< least smaller/larger eigenvalue ratio of the structure tensor
-  /// How much larger `target` shows the surface than `source` (the template is resampled
-  /// from the source at 1/scale px spacing, so an approaching point does not make the
-  /// translation-only alignment drift; 1 = same size). Must be > 0.
-  double template_scale = 1.0;
+  /// How the template is sampled from `source`: the source offset (px) of one pixel step in
+  /// `target` (column 0: a step along x, column 1: along y). The identity where the surface
+  /// looks the same in both; 1/s I where `target` shows it s times larger (an approaching
+  /// point); a distorted lens adds its local stretch at each pixel. Resampling the template
+  /// keeps the translation-only alignment from drifting where the patch's look changes.
+  /// Must be invertible.
+  Eigen::Matrix2d template_sampling = Eigen::Matrix2d::Identity();
 };
 
 /// Result of alignPatch.

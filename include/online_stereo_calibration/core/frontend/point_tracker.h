@@ -38,8 +38,9 @@ struct TrackWindow {
 /// keeps its track on the same surface point (frame-to-frame alignment alone drifts, and
 /// follows an outline sliding over the background).
 struct TrackAnchor {
-  cv::Mat crop;                                     ///< mono8 crop of that left image
-  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  ///< the point's pixel in the crop
+  cv::Mat crop;                                           ///< mono8 crop of that left image
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();        ///< the point's pixel in the crop
+  Eigen::Vector2d image_pixel = Eigen::Vector2d::Zero();  ///< ... and in that left image (raw)
   double scale = 1.0;  ///< predicted growth of the point's patch since then
 };
 

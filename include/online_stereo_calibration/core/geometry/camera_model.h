@@ -70,6 +70,10 @@ class CameraModel {
   bool undistortPixel(const Eigen::Vector2d& pixel, Eigen::Vector2d* undistorted) const;
   /// Normalized coordinates -> raw pixel.
   Eigen::Vector2d normalizedToPixel(const Eigen::Vector2d& normalized) const;
+  /// How the lens stretches small offsets around an undistorted pixel: d raw pixel /
+  /// d undistorted pixel there (central differences over +-0.5 px; exactly the identity
+  /// without distortion).
+  Eigen::Matrix2d lensJacobian(const Eigen::Vector2d& undistorted_pixel) const;
 
   /// True if the pixel lies inside the image with the given margin (pixels).
   bool isInImage(const Eigen::Vector2d& pixel, double margin = 0.0) const;
