@@ -198,7 +198,21 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
         tracker_.windows(filter.predictObservations(motion), left_camera_, right_camera_);
     std::vector<TrackMatch> found =
         tracker_.track(last_windows_, left, right, &left_used, &right_used, on_band);
-    reacquireLostTracks(left, right, on_band, &left_used, &right_used, &found);
+    // Reacquired pairs come from the whole image: besides the band, no nearer than
+    // min_point_depth (a descriptor match across the image can pair unrelated keypoints on one
+    // epipolar line at an absurd disparity). Far and parallel rays pass: after a knocked
+    // camera the current x_camr may not triangulate them.
+    const Eigen::Isometry3d T_lr = filter.extrinsics().leftToRightOptical();
+    const Eigen::Matrix3d Kl_inverse = left_camera_.K().inverse();
+    const Eigen::Matrix3d Kr_inverse = right_camera_.K().inverse();
+    auto reacquirable = [&](int l, int r) {
+      if (!on_band(l, r)) return false;
+      const auto tri = triangulateMidpoint(
+          Kl_inverse * left.undistorted[static_cast<size_t>(l)].homogeneous(),
+          Kr_inverse * right.undistorted[static_cast<size_t>(r)].homogeneous(), T_lr);
+      return !tri || tri->point_left.z() >= filter_config_.min_point_depth;
+    };
+    reacquireLostTracks(left, right, reacquirable, &left_used, &right_used, &found);
     // Sub-pixel: the point's patch in the previous left image is aligned into this one from
     // the keypoint found (so the track stays on the same surface point instead of following
     // the detector's pixel-grid jitter), then into the right image.
