@@ -861,19 +861,13 @@ TEST(CameraModel, EquidistantDistortionIsTheKannalaBrandtPolynomial) {
 TEST(CameraModel, LensJacobianIsTheEquidistantLensStretch) {
   // A pure equidistant lens (r_raw = f theta, r_pinhole = f tan theta): offsets along the
   // radius shrink by d theta / d tan theta = cos^2 theta, across it by theta / tan theta.
-  CameraIntrinsics in;
-  in.width = 640;
-  in.height = 480;
-  in.fx = in.fy = 600.0;
-  in.cx = 319.5;
-  in.cy = 239.5;
-  in.model = DistortionModel::kEquidistant;
+  CameraIntrinsics in = fisheyeCamera();
   in.distortion = {1e-12, 0.0, 0.0, 0.0};  // all zero would be a plain pinhole
   const CameraModel camera(in);
   const double n = 0.5, theta = std::atan(n);
   const double radial = 1.0 / (1.0 + n * n), across = theta / n;
-  const Eigen::Matrix2d on_x = camera.lensJacobian(Eigen::Vector2d(in.cx + 600.0 * n, in.cy));
-  const Eigen::Matrix2d on_y = camera.lensJacobian(Eigen::Vector2d(in.cx, in.cy - 600.0 * n));
+  const Eigen::Matrix2d on_x = camera.lensJacobian(Eigen::Vector2d(in.cx + in.fx * n, in.cy));
+  const Eigen::Matrix2d on_y = camera.lensJacobian(Eigen::Vector2d(in.cx, in.cy - in.fy * n));
   EXPECT_TRUE(matrixNear(on_x, Eigen::Vector2d(radial, across).asDiagonal().toDenseMatrix(), 1e-4))
       << on_x;
   EXPECT_TRUE(matrixNear(on_y, Eigen::Vector2d(across, radial).asDiagonal().toDenseMatrix(), 1e-4))
