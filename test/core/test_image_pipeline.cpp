@@ -101,7 +101,8 @@ TEST(ImagePipeline, DetectsAndFollowsASuddenYawStepOfTheCamera) {
 /// per parameter the RMSE, the last 1 sigma and the frames within 2 sigma over a window; to
 /// tell the front end's part in an overconfidence seen with `evaluate` on a bag from the
 /// odometry's. Environment: D_SCENARIO (paper_offroad, urban_planar, drift), DIAG_FRAMES
-/// (default 1151), D_WINDOW_FIRST (default 1000).
+/// (default 1151), D_WINDOW_FIRST (default 1000), D_SCENE_SEED, D_UNDULATION, D_DENSITY,
+/// D_NOISE, D_BLUR.
 TEST(ImagePipelineDiag, DISABLED_ConsistencyOverAWindow) {
   const std::string name = std::getenv("D_SCENARIO") ? std::getenv("D_SCENARIO") : "";
   MeasurementScenario scenario = name == "urban_planar" ? urbanPlanarScenario()
@@ -111,7 +112,16 @@ TEST(ImagePipelineDiag, DISABLED_ConsistencyOverAWindow) {
   const int first = std::getenv("D_WINDOW_FIRST") ? std::atoi(std::getenv("D_WINDOW_FIRST")) : 1000;
   Vector12d squared = Vector12d::Zero(), within = Vector12d::Zero(), sigma = Vector12d::Zero();
   int used = 0;
-  runImageScenario(scenario, FilterConfig(), FrontEndConfig(), ImageScenarioOptions(),
+  ImageScenarioOptions options;  // the scene as a scenario file's `rendering:` may set it
+  if (std::getenv("D_SCENE_SEED")) options.scene.seed = std::atoi(std::getenv("D_SCENE_SEED"));
+  if (std::getenv("D_UNDULATION"))
+    options.scene.ground_undulation = std::atof(std::getenv("D_UNDULATION"));
+  if (std::getenv("D_DENSITY"))
+    options.scene.structure_density = std::atof(std::getenv("D_DENSITY"));
+  // The images as `simulate` renders them by default: 1 grey level of noise, 0.5 px blur.
+  if (std::getenv("D_NOISE")) options.render.noise_sigma = std::atof(std::getenv("D_NOISE"));
+  if (std::getenv("D_BLUR")) options.render.blur_sigma = std::atof(std::getenv("D_BLUR"));
+  runImageScenario(scenario, FilterConfig(), FrontEndConfig(), options,
                    [&](const ImageFrameResult& r, const CalibrationPipeline&) {
                      if (r.filter.frame % 100 == 0) std::printf("  frame %d\n", r.filter.frame);
                      if (r.filter.frame < first) return;
