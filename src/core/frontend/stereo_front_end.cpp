@@ -107,6 +107,12 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   const Matrix12d& P = filter.covariance();
   matcher_.setGeometry(left_camera_.K(), right_camera_.K(), filter.extrinsics().T_caml_camr,
                        P.bottomRightCorner<6, 6>());
+  // Midpoint triangulation of a pair of undistorted pixels with the current x_camr.
+  const Eigen::Isometry3d T_lopt_ropt = filter.extrinsics().leftToRightOptical();
+  const Eigen::Matrix3d Kl_inv = left_camera_.K().inverse(), Kr_inv = right_camera_.K().inverse();
+  auto triangulate = [&](const Eigen::Vector2d& ul, const Eigen::Vector2d& ur) {
+    return triangulateMidpoint(Kl_inv * ul.homogeneous(), Kr_inv * ur.homogeneous(), T_lopt_ropt);
+  };
   // PointTracker::track asks about one left keypoint against many right ones (the whole
   // image when reacquiring): its seven lines are computed once, not per right keypoint.
   int left_lines_of = -1;
@@ -202,14 +208,10 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     // min_point_depth (a descriptor match across the image can pair unrelated keypoints on one
     // epipolar line at an absurd disparity). Far and parallel rays pass: after a knocked
     // camera the current x_camr may not triangulate them.
-    const Eigen::Isometry3d T_lr = filter.extrinsics().leftToRightOptical();
-    const Eigen::Matrix3d Kl_inverse = left_camera_.K().inverse();
-    const Eigen::Matrix3d Kr_inverse = right_camera_.K().inverse();
     auto reacquirable = [&](int l, int r) {
       if (!on_band(l, r)) return false;
-      const auto tri = triangulateMidpoint(
-          Kl_inverse * left.undistorted[static_cast<size_t>(l)].homogeneous(),
-          Kr_inverse * right.undistorted[static_cast<size_t>(r)].homogeneous(), T_lr);
+      const auto tri = triangulate(left.undistorted[static_cast<size_t>(l)],
+                                   right.undistorted[static_cast<size_t>(r)]);
       return !tri || tri->point_left.z() >= filter_config_.min_point_depth;
     };
     reacquireLostTracks(left, right, reacquirable, &left_used, &right_used, &found);
@@ -338,17 +340,13 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
 
   // 3. Reject what cannot make a good point: behind, too close / far, too little parallax,
   // not confirmed by the sub-pixel alignment, or where a tracked point already is.
-  const Eigen::Isometry3d T_lopt_ropt = filter.extrinsics().leftToRightOptical();
-  const Eigen::Matrix3d Kl_inv = left_camera_.K().inverse(), Kr_inv = right_camera_.K().inverse();
   std::vector<Eigen::Vector2d> tracked_pixels;
   for (const StereoObservation& o : last_tracked_) tracked_pixels.push_back(o.left_pixel);
   SpatialGrid tracked_grid;
   tracked_grid.build(tracked_pixels, left_mono.cols, left_mono.rows, 32.0);
   const double min_parallax = config_.min_parallax_deg * M_PI / 180.0;
   auto plausible = [&](const Eigen::Vector2d& ul, const Eigen::Vector2d& ur) {
-    const auto tri =
-        triangulateMidpoint(Kl_inv * Eigen::Vector3d(ul.x(), ul.y(), 1.0),
-                            Kr_inv * Eigen::Vector3d(ur.x(), ur.y(), 1.0), T_lopt_ropt);
+    const auto tri = triangulate(ul, ur);
     if (!tri) return false;
     const double depth = tri->point_left.z();
     return depth >= filter_config_.min_point_depth && depth <= filter_config_.max_point_depth &&
