@@ -107,7 +107,12 @@ class Replay {
 };
 
 /// Arguments: image width (640 or 1280) and whether search_lost_tracks is on (twice the
-/// tracks: ~60 per pair instead of ~30).
+/// tracks: ~70 per pair instead of ~30).
+void imageSizesWithAndWithoutSearch(benchmark::internal::Benchmark* benchmark) {
+  benchmark->Args({640, 0})->Args({1280, 0})->Args({640, 1})->Args({1280, 1});
+  benchmark->ArgNames({"width", "search_lost"});
+}
+
 FrontEndConfig configOf(const benchmark::State& state) {
   FrontEndConfig config;
   config.search_lost_tracks = state.range(1) != 0;
@@ -135,13 +140,7 @@ void BM_FrontEnd(benchmark::State& state) {
   state.counters["features"] = features / n;
   state.counters["matches"] = matches / n;
 }
-BENCHMARK(BM_FrontEnd)
-    ->Args({640, 0})
-    ->Args({1280, 0})
-    ->Args({640, 1})
-    ->Args({1280, 1})
-    ->ArgNames({"width", "search_lost"})
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrontEnd)->Apply(imageSizesWithAndWithoutSearch)->Unit(benchmark::kMillisecond);
 
 void BM_WholeFrame(benchmark::State& state) {
   const Drive& d = drive(static_cast<int>(state.range(0)));
@@ -159,13 +158,7 @@ void BM_WholeFrame(benchmark::State& state) {
   }
   state.counters["points"] = points / static_cast<double>(state.iterations());
 }
-BENCHMARK(BM_WholeFrame)
-    ->Args({640, 0})
-    ->Args({1280, 0})
-    ->Args({640, 1})
-    ->Args({1280, 1})
-    ->ArgNames({"width", "search_lost"})
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WholeFrame)->Apply(imageSizesWithAndWithoutSearch)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace osc
