@@ -655,6 +655,8 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
   envd("D_EIG", &fe.min_patch_eigen_ratio);
   envd("D_ANCHOR", &fe.max_anchor_shift);
   envd("D_TSHIFT", &fe.max_temporal_shift);
+  envi("D_CORNER", &fe.corner_half_size);
+  envd("D_CORNER_SHIFT", &fe.max_corner_shift);
   envd("D_MAXD", &fe.max_descriptor_distance);
   envd("D_TMAXD", &fe.max_track_descriptor_distance);
   envi("D_HALF", &fe.patch_half_size);
