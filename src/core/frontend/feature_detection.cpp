@@ -124,16 +124,8 @@ void SpatialGrid::query(const Eigen::Vector2d& min, const Eigen::Vector2d& max,
   }
 }
 
-// The x86-64 baseline has no popcount instruction (GCC calls a library routine, ~2 % of a
-// frame): a second version for CPUs with POPCNT, chosen at load time.
-#if defined(__x86_64__) && defined(__GNUC__) && defined(__GLIBC__)  // ifunc: glibc
-#define OSC_WITH_POPCNT_CLONE __attribute__((target_clones("popcnt", "default")))
-#else
-#define OSC_WITH_POPCNT_CLONE
-#endif
-
-OSC_WITH_POPCNT_CLONE bool cornerNear(const cv::Mat& image, const Eigen::Vector2d& pixel,
-                                      int half_size, double max_shift, Eigen::Vector2d* corner) {
+bool cornerNear(const cv::Mat& image, const Eigen::Vector2d& pixel, int half_size, double max_shift,
+                Eigen::Vector2d* corner) {
   std::vector<cv::Point2f> at = {
       cv::Point2f(static_cast<float>(pixel.x()), static_cast<float>(pixel.y()))};
   cv::cornerSubPix(image, at, cv::Size(half_size, half_size), cv::Size(-1, -1),
@@ -144,7 +136,16 @@ OSC_WITH_POPCNT_CLONE bool cornerNear(const cv::Mat& image, const Eigen::Vector2
   return true;
 }
 
-double hammingDistance(const unsigned char* a, const unsigned char* b, int bytes) {
+// The x86-64 baseline has no popcount instruction (GCC calls a library routine, ~2 % of a
+// frame): a second version for CPUs with POPCNT, chosen at load time.
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__GLIBC__)  // ifunc: glibc
+#define OSC_WITH_POPCNT_CLONE __attribute__((target_clones("popcnt", "default")))
+#else
+#define OSC_WITH_POPCNT_CLONE
+#endif
+
+OSC_WITH_POPCNT_CLONE double hammingDistance(const unsigned char* a, const unsigned char* b,
+                                             int bytes) {
   int bits = 0;
   int k = 0;
   for (; k + 8 <= bytes; k += 8) {

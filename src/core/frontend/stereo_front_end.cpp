@@ -231,7 +231,6 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     };
     for (const TrackMatch& m : found) {
       Eigen::Vector2d left_raw = left.raw[static_cast<size_t>(m.left)];
-      Eigen::Vector2d left_und = left.undistorted[static_cast<size_t>(m.left)];
       Eigen::Vector2d previous;
       if (!previous_left_.empty() && tracker_.leftPixel(m.id, &previous)) {
         temporal.template_sampling =
@@ -240,10 +239,9 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
             alignPatch(previous_left_, previous, left_mono, left_raw, temporal);
         if (!a.ok) continue;
         left_raw = a.position;
-        left_und = left_camera_.undistortPixel(left_raw);
       }
       if (!anchored(m.id, &left_raw)) continue;
-      left_und = left_camera_.undistortPixel(left_raw);
+      const Eigen::Vector2d left_und = left_camera_.undistortPixel(left_raw);
       Eigen::Vector2d right_raw, right_und;
       if (!refine(left_raw, left_und, right.raw[static_cast<size_t>(m.right)], &right_raw,
                   &right_und) ||
