@@ -178,30 +178,28 @@ TEST(FrontEnd, MatchesAndTracksAreCorrectOnRenderedDrive) {
 
 TEST(FrontEnd, ImagesRenderedAsTheBagsAre) {
   // `simulate` renders its drives (the demo, the 1500-frame evaluations) with 1 grey level of
-  // noise and 0.5 px blur (scenario_file.h), the drive above without either.
-  // NOT AT TARGET: tracks on their birth point 98.91 % here (60 frames; 98.40 % over the
-  // 120 frames of the diagnostic with D_NOISE=1 D_BLUR=0.5). Most misses are a few long
-  // tracks: a keypoint on the sky beside an outline whose stereo pair drifts by 2-4 px, and
-  // an outline against the backdrop that slides ~0.3 px per frame.
-  const int frames = 60;
+  // noise and 0.5 px blur (scenario_file.h), the drive above without either. 120 frames: the
+  // misses are a few long tracks beside an outline whose stereo pair slid along it, so a short
+  // drive can miss them. Measured: tracks 99.38 % on their birth point (100.00 % over 60
+  // frames); 98.40 % before refined pairs were held to their own noise across the epipolar
+  // line (EpipolarMatcher::refinedBandHalfWidth).
+  const int frames = 120;
   ImageScenarioOptions as_bags;
   as_bags.render.noise_sigma = 1.0;
   as_bags.render.blur_sigma = 0.5;
-  DriveBars bars;
-  bars.tracks_correct = 0.985;
-  expectGoodDrive(drive(shortDrive(frames), confidentConfig(), FrontEndConfig(), as_bags), frames,
-                  bars);
+  expectGoodDrive(drive(shortDrive(frames), confidentConfig(), FrontEndConfig(), as_bags), frames);
 }
 
 TEST(FrontEnd, NoisyBlurredFlickeringImages) {
   // A poorer camera than the bags' (1 grey level, 0.5 px): sensor noise of 3 grey levels,
   // 0.8 px optical blur, and auto-exposure flicker of +-10 % per image, independently left
-  // and right. Measured (20 frames): stereo matches 99.75 % correct, new points 99.37 %,
-  // tracks 98.44 % stereo-correct and 97.66 % on their birth point, 58 points alive.
-  // NOT AT TARGET: tracks (99 % wanted). The wrong ones are keypoints the noise makes in the
-  // sky a few pixels off an object's outline: the patch is the outline's, so the pair is
-  // consistent every frame with the object's disparity but the pixel is 2-6 px off it.
-  // (Before new points were moved to their sub-pixel corner: 94.2 % and 93.3 %.)
+  // and right. Measured (20 frames): stereo matches 99.84 % correct, new points 99.50 %,
+  // tracks 99.20 % stereo-correct and 98.00 % on their birth point, 60 points alive.
+  // Below the 99 % of the clean drives on the birth point: the wrong ones are keypoints the
+  // noise makes in the sky a few pixels off an object's outline: the patch is the outline's,
+  // so the pair is consistent every frame with the object's disparity but the pixel is 2-6 px
+  // off it. (94.2 % and 93.3 % before new points were moved to their sub-pixel corner, 98.44 %
+  // and 97.66 % before refined pairs were held to their own noise across the epipolar line.)
   const int frames = 20;
   ImageScenarioOptions poor;
   poor.render.noise_sigma = 3.0;
@@ -214,8 +212,8 @@ TEST(FrontEnd, NoisyBlurredFlickeringImages) {
                std::invalid_argument);
   DriveBars bars;
   bars.tracks_per_frame = 20;
-  bars.tracks_stereo_correct = 0.975;
-  bars.tracks_correct = 0.965;
+  bars.tracks_stereo_correct = 0.985;
+  bars.tracks_correct = 0.975;
   expectGoodDrive(f, frames, bars);
 }
 
@@ -270,8 +268,33 @@ TEST(FrontEnd, WrongCalibrationBandStillFindsCorrectMatches) {
   std::printf("  wrong calibration: %d matches, %d correct\n", first.matches_checked,
               first.matches_correct);
   EXPECT_GE(first.matches_checked, 100);
-  // NOT YET AT TARGET (99 %): measured 98.4 % (1097 of 1115) in the first, widest band.
-  EXPECT_GE(first.matches_correct, 0.975 * first.matches_checked);
+  // Measured 1114 of 1115 in the first, widest band.
+  EXPECT_GE(first.matches_correct, 0.99 * first.matches_checked);
+}
+
+TEST(EpipolarMatcher, RefinedPairsHaveNoKeypointFloorButKeepTheCalibrationsSpread) {
+  FrontEndConfig config;
+  config.pixel_sigma = 0.1;  // keypoints' band below the floor
+  EpipolarMatcher matcher(config, 1.0);
+  Eigen::Matrix3d K;
+  K << 500, 0, 320, 0, 500, 240, 0, 0, 1;
+  Eigen::Isometry3d T_caml_camr = Eigen::Isometry3d::Identity();
+  T_caml_camr.translation() = Eigen::Vector3d(0.0, -0.5, 0.0);  // body frames: right is -y
+  const Eigen::Vector2d left(300.0, 200.0), right(290.0, 200.0);
+  matcher.setGeometry(K, K, T_caml_camr, Matrix6d::Zero());
+  const EpipolarMatcher::Lines lines = matcher.lines(left);
+  // A keypoint on the pixel grid keeps min_band; a refined pair its own noise only.
+  EXPECT_DOUBLE_EQ(matcher.bandHalfWidth(lines, right), config.min_band);
+  EXPECT_NEAR(matcher.refinedBandHalfWidth(lines, right, config.refined_pixel_sigma),
+              config.band_sigmas * std::sqrt(2.0) * config.refined_pixel_sigma, 1e-9);
+  EXPECT_LT(matcher.refinedBandHalfWidth(lines, right, config.refined_pixel_sigma), 0.5);
+  // An uncertain x_camr (1 deg about the baseline tilts the line) widens both.
+  Matrix6d P = Matrix6d::Zero();
+  P(3, 3) = std::pow(1.0 * kDeg, 2);
+  matcher.setGeometry(K, K, T_caml_camr, P);
+  const EpipolarMatcher::Lines uncertain = matcher.lines(left);
+  EXPECT_GT(matcher.refinedBandHalfWidth(uncertain, right, config.refined_pixel_sigma), 1.0);
+  EXPECT_GT(matcher.bandHalfWidth(uncertain, right), config.min_band);
 }
 
 /// A smooth random texture (blurred noise), mono8.
@@ -599,7 +622,8 @@ double diagPair(const DiagCtx& c, const char* tag, const Eigen::Vector2d& pl,
 /// and depth discontinuity around the pixel (edgeL/R: largest relative depth change within
 /// 2 px; 10 = sky), every track off its birth point (B), and a SUMMARY. Environment:
 /// DIAG_FRAMES, DIAG_DISTORT (plumb_bob, or "equidistant"), D_QUIET, D_IMG (debug image of
-/// frame 5), D_CROP=id (x8 crops of that track's images, /tmp/crop_ID_FRAME.png), D_NOISE,
+/// frame 5), D_CROP=id (x8 crops of that point's images from its birth on, /tmp/crop_ID_FRAME.png,
+/// and the depths around it), D_NOISE,
 /// D_BLUR, D_FLICKER (the image options) and D_* overrides of the FrontEndConfig.
 TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
   const int frames = std::getenv("DIAG_FRAMES") ? std::atoi(std::getenv("DIAG_FRAMES")) : 25;
@@ -653,6 +677,7 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
   envd("D_SNCC", &fe.min_search_ncc);
   envd("D_FB", &fe.max_forward_backward);
   envd("D_EIG", &fe.min_patch_eigen_ratio);
+  envd("D_RSIG", &fe.refined_pixel_sigma);
   envd("D_ANCHOR", &fe.max_anchor_shift);
   envd("D_TSHIFT", &fe.max_temporal_shift);
   envi("D_CORNER", &fe.corner_half_size);
@@ -661,6 +686,47 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
   envd("D_TMAXD", &fe.max_track_descriptor_distance);
   envi("D_HALF", &fe.patch_half_size);
   const bool quiet = std::getenv("D_QUIET") != nullptr;
+  // D_CROP=id: x8 crops of that point's left and right images around its pixels
+  // (/tmp/crop_ID_FRAME.png; the reported pixel in red, `left_truth` / `right_truth` in green)
+  // and the left image's depth (m, -1 sky) every 2 px around it. True if it was that point.
+  auto showCrop = [&](int frame, const StereoObservation& o, const Eigen::Vector2d& left_truth,
+                      const Eigen::Vector2d& right_truth) {
+    if (!std::getenv("D_CROP") || o.id != std::strtoul(std::getenv("D_CROP"), nullptr, 10))
+      return false;
+    RenderOptions ro = options.render;
+    ro.noise_seed = 2u * static_cast<unsigned>(frame) + 1u;
+    const cv::Mat li = renderer.render(*c.left, c.Tl, ro);
+    ro.noise_seed += 1u;
+    const cv::Mat ri = renderer.render(*c.right, c.Tr, ro);
+    auto crop = [](const cv::Mat& im, const Eigen::Vector2d& at, const Eigen::Vector2d& truth) {
+      const int R = 12, S = 8;
+      cv::Mat out;
+      cv::Mat patch;
+      cv::getRectSubPix(im, cv::Size(2 * R + 1, 2 * R + 1),
+                        cv::Point2f(std::round(at.x()), std::round(at.y())), patch);
+      cv::resize(patch, out, cv::Size(), S, S, cv::INTER_NEAREST);
+      cv::cvtColor(out, out, cv::COLOR_GRAY2BGR);
+      auto mark = [&](const Eigen::Vector2d& p, cv::Scalar col) {
+        const Eigen::Vector2d q =
+            (p - Eigen::Vector2d(std::round(at.x()) - R, std::round(at.y()) - R)) * S +
+            Eigen::Vector2d(S / 2, S / 2);
+        cv::circle(out, cv::Point(q.x(), q.y()), 5, col, 2);
+      };
+      mark(at, cv::Scalar(0, 0, 255));
+      mark(truth, cv::Scalar(0, 255, 0));
+      return out;
+    };
+    std::printf("DEPTHS id %lu frame %d\n", (unsigned long)o.id, frame);
+    for (int dy = -6; dy <= 6; dy += 2) {
+      for (int dx = -6; dx <= 6; dx += 2)
+        std::printf(" %6.1f", diagDepth(c, *c.left, c.Tl, o.left_pixel + Eigen::Vector2d(dx, dy)));
+      std::printf("\n");
+    }
+    cv::Mat both;
+    cv::hconcat(crop(li, o.left_pixel, left_truth), crop(ri, o.right_pixel, right_truth), both);
+    cv::imwrite("/tmp/crop_" + std::to_string(o.id) + "_" + std::to_string(frame) + ".png", both);
+    return true;
+  };
   DriveFigures f;
   std::map<PointId, std::pair<std::vector<Eigen::Vector3d>, int>> births;
   runImageScenario(
@@ -698,38 +764,21 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
               pl = ql, pr = qr, vl = wl, vr = wr, el = dl, er = dr;
             }
           }
-          if (std::getenv("D_CROP") && o.id == std::strtoul(std::getenv("D_CROP"), nullptr, 10)) {
-            // Crops (x8) of this track's left and right images around its pixels: the
-            // reported pixel in red, the nearest birth candidate's projection in green.
-            RenderOptions ro = options.render;
-            ro.noise_seed = 2u * static_cast<unsigned>(r.filter.frame) + 1u;
-            const cv::Mat li = renderer.render(*c.left, c.Tl, ro);
-            ro.noise_seed += 1u;
-            const cv::Mat ri = renderer.render(*c.right, c.Tr, ro);
-            auto crop = [](const cv::Mat& im, const Eigen::Vector2d& at,
-                           const Eigen::Vector2d& truth) {
-              const int R = 12, S = 8;
-              cv::Mat out;
-              cv::Mat patch;
-              cv::getRectSubPix(im, cv::Size(2 * R + 1, 2 * R + 1),
-                                cv::Point2f(std::round(at.x()), std::round(at.y())), patch);
-              cv::resize(patch, out, cv::Size(), S, S, cv::INTER_NEAREST);
-              cv::cvtColor(out, out, cv::COLOR_GRAY2BGR);
-              auto mark = [&](const Eigen::Vector2d& p, cv::Scalar col) {
-                const Eigen::Vector2d q =
-                    (p - Eigen::Vector2d(std::round(at.x()) - R, std::round(at.y()) - R)) * S +
-                    Eigen::Vector2d(S / 2, S / 2);
-                cv::circle(out, cv::Point(q.x(), q.y()), 5, col, 2);
-              };
-              mark(at, cv::Scalar(0, 0, 255));
-              mark(truth, cv::Scalar(0, 255, 0));
-              return out;
-            };
-            cv::Mat both;
-            cv::hconcat(crop(li, o.left_pixel, pl), crop(ri, o.right_pixel, pr), both);
-            cv::imwrite(
-                "/tmp/crop_" + std::to_string(o.id) + "_" + std::to_string(r.filter.frame) + ".png",
-                both);
+          showCrop(r.filter.frame, o, pl, pr);
+          if (std::getenv("D_INNOV")) {  // the track's innovation against the filter's prediction
+            for (const TrackWindow& w : pipeline.frontEnd().lastWindows()) {
+              if (w.id != o.id) continue;
+              const Eigen::Vector4d z(o.left_pixel.x(), o.left_pixel.y(), o.right_pixel.x(),
+                                      o.right_pixel.y());
+              const Eigen::Vector4d e = z - w.z;
+              std::printf(
+                  "I id %lu frame %d age %d bad %d e %.2f %.2f %.2f %.2f nis %.2f sd %.2f %.2f "
+                  "%.2f %.2f\n",
+                  (unsigned long)o.id, r.filter.frame, r.filter.frame - it->second.second,
+                  !(vl && vr && el <= 1.5 && er <= 1.5), e(0), e(1), e(2), e(3),
+                  e.dot(w.S.inverse() * e), std::sqrt(w.S(0, 0)), std::sqrt(w.S(1, 1)),
+                  std::sqrt(w.S(2, 2)), std::sqrt(w.S(3, 3)));
+            }
           }
           if (!(vl && vr && el <= 1.5 && er <= 1.5) && !quiet)
             std::printf(
@@ -745,6 +794,9 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
           births[o.id] = {scenePointsOfStereoMatch(renderer, *c.left, *c.right, c.Tl, c.Tr,
                                                    o.left_pixel, o.right_pixel, 1.5),
                           r.filter.frame};
+          if (showCrop(r.filter.frame, o, o.left_pixel, o.right_pixel))
+            std::printf("BIRTH of %lu above: disparity %.2f\n", (unsigned long)o.id,
+                        o.left_pixel.x() - o.right_pixel.x());
         }
         if (std::getenv("D_IMG") && r.filter.frame == 5)
           cv::imwrite(std::getenv("D_IMG"), pipeline.debugImage());

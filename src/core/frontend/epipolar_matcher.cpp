@@ -60,11 +60,19 @@ EpipolarMatcher::Lines EpipolarMatcher::lines(const Eigen::Vector2d& left) const
 }
 
 double EpipolarMatcher::bandHalfWidth(const Lines& lines, const Eigen::Vector2d& right) const {
-  return bandHalfWidth(lines, right, config_.pixel_sigma);
+  return std::clamp(
+      config_.band_sigmas * std::sqrt(lineDistanceVariance(lines, right, config_.pixel_sigma)),
+      config_.min_band, config_.max_band);
 }
 
-double EpipolarMatcher::bandHalfWidth(const Lines& lines, const Eigen::Vector2d& right,
-                                      double pixel_sigma) const {
+double EpipolarMatcher::refinedBandHalfWidth(const Lines& lines, const Eigen::Vector2d& right,
+                                             double pixel_sigma) const {
+  return std::min(config_.band_sigmas * std::sqrt(lineDistanceVariance(lines, right, pixel_sigma)),
+                  config_.max_band);
+}
+
+double EpipolarMatcher::lineDistanceVariance(const Lines& lines, const Eigen::Vector2d& right,
+                                             double pixel_sigma) const {
   const Eigen::Vector3d r(right.x(), right.y(), 1.0);
   const double d0 = lines.nominal.dot(r);
   double variance = 2.0 * pixel_sigma * pixel_sigma;
@@ -72,7 +80,7 @@ double EpipolarMatcher::bandHalfWidth(const Lines& lines, const Eigen::Vector2d&
     const double dj = lines.sigma[j].dot(r) - d0;
     variance += dj * dj;
   }
-  return std::clamp(config_.band_sigmas * std::sqrt(variance), config_.min_band, config_.max_band);
+  return variance;
 }
 
 double EpipolarMatcher::bandHalfWidth(const Eigen::Vector2d& left,

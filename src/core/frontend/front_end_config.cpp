@@ -238,7 +238,8 @@ const std::vector<FrontEndParameterSpec>& frontEndParameterTable() {
       real("min_patch_eigen_ratio", &C::min_patch_eigen_ratio, 0.0, 1.0, kClosed,
            "least small/large eigenvalue ratio of the patch's structure tensor (edges fail)"),
       real("refined_pixel_sigma", &C::refined_pixel_sigma, 0.0, 10.0, kOpen,
-           "pixel noise (px) per image of the epipolar band check of a refined pair"),
+           "pixel noise (px) per image of the epipolar check of a sub-pixel pair (no min_band "
+           "floor)"),
       // --- spatial sampling ---
       integer("bucket_cols", &C::bucket_cols, 1, 64, "bucketing grid columns for new points"),
       integer("bucket_rows", &C::bucket_rows, 1, 64, "bucketing grid rows for new points"),

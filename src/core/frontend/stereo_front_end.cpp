@@ -145,7 +145,7 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     *right_und = right_camera_.undistortPixel(a.position);
     const EpipolarMatcher::Lines lines = matcher_.lines(left_und);
     if (std::abs(lines.nominal.dot(right_und->homogeneous())) >
-        matcher_.bandHalfWidth(lines, *right_und, config_.refined_pixel_sigma)) {
+        matcher_.refinedBandHalfWidth(lines, *right_und, config_.refined_pixel_sigma)) {
       return false;
     }
     return true;

@@ -55,8 +55,12 @@ class EpipolarMatcher {
   Lines lines(const Eigen::Vector2d& left) const;
   /// bandHalfWidth with the left pixel's lines computed once.
   double bandHalfWidth(const Lines& lines, const Eigen::Vector2d& right) const;
-  /// The same with another pixel noise (px per image) than config.pixel_sigma.
-  double bandHalfWidth(const Lines& lines, const Eigen::Vector2d& right, double pixel_sigma) const;
+  /// The band of a sub-pixel (refined) pair: `pixel_sigma` (px per image) in place of
+  /// config.pixel_sigma and no min_band floor (that floor is for keypoints on the pixel grid;
+  /// a refined pair off its line by more than its own noise and x_camr's uncertainty has
+  /// slid, e.g. along an outline).
+  double refinedBandHalfWidth(const Lines& lines, const Eigen::Vector2d& right,
+                              double pixel_sigma) const;
 
   /// Matches in undistorted coordinates. Keypoints flagged in left_used / right_used (may be
   /// empty) take no part. A match passes the descriptor bound and Lowe's ratio test from
@@ -70,6 +74,10 @@ class EpipolarMatcher {
   const Eigen::Matrix3d& fundamental() const { return F_; }
 
  private:
+  /// Variance (px^2) of a right pixel's distance to the line: 2 pixel_sigma^2 plus the
+  /// spread of the six sigma-perturbed lines.
+  double lineDistanceVariance(const Lines& lines, const Eigen::Vector2d& right,
+                              double pixel_sigma) const;
   FrontEndConfig config_;
   double min_depth_;
   double max_depth_;

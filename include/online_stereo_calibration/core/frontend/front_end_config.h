@@ -78,9 +78,11 @@ struct FrontEndConfig {
   /// Least ratio of the smaller to the larger eigenvalue of the patch's structure tensor,
   /// [0, 1]: below, the patch is a straight edge (its position along the edge is unknown).
   double min_patch_eigen_ratio = 0.05;
-  /// Pixel noise (px) per image of a refined pair: the refined right pixel must lie in the
-  /// epipolar band computed with it in place of pixel_sigma, (0, 10].
-  double refined_pixel_sigma = 0.35;
+  /// Pixel noise (px) per image of a refined (sub-pixel) pair: the refined right pixel must
+  /// lie within band_sigmas of the epipolar line's distance sigma computed with it in place of
+  /// pixel_sigma and without the min_band floor (0.3 px with a well-known x_camr), (0, 10].
+  /// A pair aligned along an outline slides off the line by a few tenths of a pixel.
+  double refined_pixel_sigma = 0.07;
 
   // --- spatial sampling ---
   /// Bucketing grid (cells per axis) for new points: the best match per cell, and none in a
