@@ -622,9 +622,10 @@ double diagPair(const DiagCtx& c, const char* tag, const Eigen::Vector2d& pl,
 /// and depth discontinuity around the pixel (edgeL/R: largest relative depth change within
 /// 2 px; 10 = sky), every track off its birth point (B), and a SUMMARY. Environment:
 /// DIAG_FRAMES, DIAG_DISTORT (plumb_bob, or "equidistant"), D_QUIET, D_IMG (debug image of
-/// frame 5), D_CROP=id (x8 crops of that point's images from its birth on, /tmp/crop_ID_FRAME.png,
-/// and the depths around it), D_NOISE,
-/// D_BLUR, D_FLICKER (the image options) and D_* overrides of the FrontEndConfig.
+/// frame 5), D_CROP=id (x8 crops of that point's images from its birth on,
+/// /tmp/crop_ID_FRAME.png, and the depths around it), D_INNOV (each track's innovation against
+/// the filter's prediction: I lines), D_NOISE, D_BLUR, D_FLICKER (the image options) and D_*
+/// overrides of the FrontEndConfig.
 TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
   const int frames = std::getenv("DIAG_FRAMES") ? std::atoi(std::getenv("DIAG_FRAMES")) : 25;
   MeasurementScenario s = shortDrive(frames);
