@@ -19,6 +19,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "online_stereo_calibration/core/frontend/bucketing.h"
+#include "online_stereo_calibration/core/frontend/epipolar_trend.h"
 #include "online_stereo_calibration/core/frontend/feature_detection.h"
 #include "online_stereo_calibration/core/frontend/patch_alignment.h"
 #include "online_stereo_calibration/core/frontend/stereo_front_end.h"
@@ -295,6 +296,40 @@ TEST(EpipolarMatcher, RefinedPairsHaveNoKeypointFloorButKeepTheCalibrationsSprea
   const EpipolarMatcher::Lines uncertain = matcher.lines(left);
   EXPECT_GT(matcher.refinedBandHalfWidth(uncertain, right, config.refined_pixel_sigma), 1.0);
   EXPECT_GT(matcher.bandHalfWidth(uncertain, right), config.min_band);
+}
+
+TEST(EpipolarTrend, RecoversTheCommonDistanceDespiteSlidPairs) {
+  // A knocked right camera: 0.8 px everywhere (pitch_r) and 0.3 px per focal length of column
+  // (roll_r); one pair in five slid along an outline by a further +-1 px.
+  const double center = 320.0, focal = 500.0;
+  const Eigen::Vector2d truth(0.8, 0.3);
+  cv::RNG rng(7);
+  std::vector<EpipolarResidual> residuals;
+  for (int i = 0; i < 200; ++i) {
+    EpipolarResidual r;
+    r.right_pixel = Eigen::Vector2d(rng.uniform(0.0, 640.0), rng.uniform(0.0, 480.0));
+    r.distance =
+        truth.dot(Eigen::Vector2d(1.0, (r.right_pixel.x() - center) / focal)) + rng.gaussian(0.05);
+    if (i % 5 == 0) r.distance += (i % 10 == 0) ? 1.0 : -1.0;
+    residuals.push_back(r);
+  }
+  const EpipolarTrend trend = EpipolarTrend::fit(residuals, center, focal);
+  EXPECT_NEAR(trend.coefficients()(0), truth(0), 0.02);
+  EXPECT_NEAR(trend.coefficients()(1), truth(1), 0.05);
+  int within = 0;
+  for (int i = 1; i < 200; ++i) {
+    if (i % 5 == 0) continue;
+    const EpipolarResidual& r = residuals[static_cast<size_t>(i)];
+    within += std::abs(r.distance - trend.at(r.right_pixel)) < 0.2;
+  }
+  EXPECT_GE(within, 155);  // of the 159 unslid pairs (0.05 px noise)
+  // Too few pairs: no trend, every pair against its own line.
+  std::vector<EpipolarResidual> few(residuals.begin(),
+                                    residuals.begin() + EpipolarTrend::kMinResiduals - 1);
+  EXPECT_EQ(EpipolarTrend::fit(few, center, focal).coefficients(), Eigen::Vector2d::Zero());
+  // A common distance within the pairs' own noise is no trend either.
+  for (EpipolarResidual& r : residuals) r.distance = 0.03 + rng.gaussian(0.05);
+  EXPECT_EQ(EpipolarTrend::fit(residuals, center, focal).coefficients(), Eigen::Vector2d::Zero());
 }
 
 /// A smooth random texture (blurred noise), mono8.

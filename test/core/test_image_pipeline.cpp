@@ -4,10 +4,13 @@
 /// start errors; the calibration must converge and stay consistent.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <string>
+#include <vector>
 
 #include "online_stereo_calibration/core/sim/image_scenario_runner.h"
 
@@ -94,6 +97,67 @@ TEST(ImagePipeline, DetectsAndFollowsASuddenYawStepOfTheCamera) {
   // Back from 10 deg to within 0.3 deg (measured -0.05 deg 29 frames after the step).
   EXPECT_LT(std::abs(yaw_error), 0.3 * kDeg);
   EXPECT_GE(last.filter.tracked_points, 30);
+}
+
+/// A calibrated start (no start error, small x_caml sigmas) of the paper drive whose x_camr
+/// parameter `param` (6-11) steps by `step` (m or rad) at frame 100; images as the bags'.
+std::vector<ImageFrameResult> rightCameraStep(
+    int param, double step, int frames,
+    const std::function<void(const ImageFrameResult&, const CalibrationPipeline&)>& on_frame) {
+  MeasurementScenario scenario = paperOffroadScenario();
+  scenario.frames = frames;
+  scenario.step_frame = 100;
+  scenario.initial_error.setZero();
+  scenario.step.setZero();
+  scenario.step(param) = step;
+  FilterConfig calibrated;
+  calibrated.initial_caml_translation_sigma = 0.02;
+  calibrated.initial_caml_rotation_sigma = 0.2 * kDeg;
+  ImageScenarioOptions as_bags;
+  as_bags.render.noise_sigma = 1.0;
+  as_bags.render.blur_sigma = 0.5;
+  return runImageScenario(scenario, calibrated, FrontEndConfig(), as_bags, on_frame);
+}
+
+// A small knock of the right camera (0.1 deg of pitch_r: every right pixel ~1 px off its
+// epipolar line) meets refined pairs that must lie within ~0.3 px of their lines: measured
+// against the frame's common distance from the lines (EpipolarTrend) they still reach the
+// filter, which follows the knock, instead of all being refused (before: 76 points -> 1 at
+// the step, pitch_r stuck 0.1 deg off).
+TEST(ImagePipeline, KeepsTrackingThroughASmallKnockOfTheRightCamera) {
+  constexpr int kPitchR = 10;
+  int fewest_after_step = 1000;
+  const std::vector<ImageFrameResult> results = rightCameraStep(
+      kPitchR, 0.1 * kDeg, 130, [&](const ImageFrameResult& r, const CalibrationPipeline&) {
+        if (r.filter.frame >= 100)
+          fewest_after_step = std::min(fewest_after_step, r.filter.tracked_points);
+      });
+  ASSERT_EQ(results.size(), 130u);
+  const ImageFrameResult& last = results.back();
+  const double error = last.filter.parameters(kPitchR) - last.filter.truth(kPitchR);
+  std::printf("  fewest points after the step %d; pitch_r error at frame %d: %.4f deg\n",
+              fewest_after_step, last.filter.frame, error / kDeg);
+  EXPECT_GE(fewest_after_step, 50);
+  // Measured -0.027 deg 30 frames after the 0.1 deg step (the filter follows it through
+  // x_camr's drift noise: no jump is detected for so small a change).
+  EXPECT_LT(std::abs(error), 0.05 * kDeg);
+}
+
+/// Diagnostics: rightCameraStep with D_PARAM (6-11, default 10 = pitch_r), D_STEP (deg or m,
+/// default 0.1) and DIAG_FRAMES (default 160); prints per frame from 95 on the tracked points,
+/// the jump flag and that parameter's error and sigma.
+TEST(ImagePipelineDiag, DISABLED_StepOfTheRightCamera) {
+  const int param = std::getenv("D_PARAM") ? std::atoi(std::getenv("D_PARAM")) : 10;
+  const double unit = param % 6 >= 3 ? kDeg : 1.0;
+  const double step = (std::getenv("D_STEP") ? std::atof(std::getenv("D_STEP")) : 0.1) * unit;
+  const int frames = std::getenv("DIAG_FRAMES") ? std::atoi(std::getenv("DIAG_FRAMES")) : 160;
+  rightCameraStep(param, step, frames, [&](const ImageFrameResult& r, const CalibrationPipeline&) {
+    if (r.filter.frame < 95) return;
+    std::printf("  frame %d points %d jump %d error %.4f sigma %.4f\n", r.filter.frame,
+                r.filter.tracked_points, r.filter.jump_detected,
+                (r.filter.parameters(param) - r.filter.truth(param)) / unit,
+                r.filter.sigmas(param) / unit);
+  });
 }
 
 /// Diagnostics, not a check (run with --gtest_also_run_disabled_tests): a whole drive at image

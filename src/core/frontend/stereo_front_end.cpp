@@ -51,6 +51,26 @@ Eigen::Matrix2d templateSampling(const CameraModel& camera, const Eigen::Vector2
          camera.lensJacobian(camera.undistortPixel(to)).inverse();
 }
 
+/// A refined pair against its epipolar line: the right pixel's signed distance from the line
+/// (px) and the half-width that its own noise and x_camr's spread allow
+/// (EpipolarMatcher::refinedBandHalfWidth).
+struct LineFit {
+  double distance = 0.0;
+  double band = 0.0;
+};
+
+/// A refined pair waiting for the frame's epipolar trend.
+struct RefinedPair {
+  PointId id = 0;  ///< tracked point; unused for new matches
+  int match = -1;  ///< index of the stereo match; unused for tracks
+  Eigen::Vector2d left_raw, right_raw, left_und, right_und;
+  LineFit line;
+};
+
+EpipolarResidual residualOf(const RefinedPair& pair) {
+  return {pair.line.distance, pair.right_und};
+}
+
 /// The anchor of a new point: a crop of its left image around the pixel, wide enough for its
 /// patch resampled at half the size (radius 2 (half_size + 1) + 1), clipped at the border.
 TrackAnchor makeAnchor(const cv::Mat& image, const Eigen::Vector2d& pixel, int half_size) {
@@ -128,7 +148,8 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   };
   // Sub-pixel right pixel of a pair: the left keypoint's patch aligned into the right image;
   // false if the alignment is unreliable (edge, occlusion, different content) or leaves the
-  // epipolar band.
+  // keypoints' epipolar band. Its own, much narrower band is checked once the frame's common
+  // distance from the lines is known (onTrend).
   PatchAlignmentConfig alignment;
   alignment.half_size = config_.patch_half_size;
   alignment.max_shift = config_.max_refinement_shift;
@@ -136,19 +157,28 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   alignment.min_eigenvalue = config_.min_patch_eigen_ratio;
   auto refine = [&](const Eigen::Vector2d& left_raw, const Eigen::Vector2d& left_und,
                     const Eigen::Vector2d& right_guess, Eigen::Vector2d* right_raw,
-                    Eigen::Vector2d* right_und, double max_shift = 0.0) {
-    PatchAlignmentConfig c = alignment;
-    if (max_shift > 0.0) c.max_shift = max_shift;
-    const PatchAlignment a = alignPatch(left_mono, left_raw, right_mono, right_guess, c);
+                    Eigen::Vector2d* right_und, LineFit* line) {
+    const PatchAlignment a = alignPatch(left_mono, left_raw, right_mono, right_guess, alignment);
     if (!a.ok) return false;
     *right_raw = a.position;
     *right_und = right_camera_.undistortPixel(a.position);
     const EpipolarMatcher::Lines lines = matcher_.lines(left_und);
-    if (std::abs(lines.nominal.dot(right_und->homogeneous())) >
-        matcher_.refinedBandHalfWidth(lines, *right_und, config_.refined_pixel_sigma)) {
-      return false;
+    line->distance = lines.nominal.dot(right_und->homogeneous());
+    line->band = matcher_.refinedBandHalfWidth(lines, *right_und, config_.refined_pixel_sigma);
+    return std::abs(line->distance) <= std::max(config_.min_band, line->band);
+  };
+  // The refined pair's own band, about the frame's common distance from the lines.
+  auto onTrend = [](const EpipolarTrend& trend, const RefinedPair& pair) {
+    return std::abs(pair.line.distance - trend.at(pair.right_und)) <= pair.line.band;
+  };
+  auto fitTrend = [&](const std::vector<const std::vector<RefinedPair>*>& sets,
+                      const EpipolarTrend& fallback) {
+    std::vector<EpipolarResidual> residuals;
+    for (const std::vector<RefinedPair>* set : sets) {
+      for (const RefinedPair& pair : *set) residuals.push_back(residualOf(pair));
     }
-    return true;
+    if (static_cast<int>(residuals.size()) < EpipolarTrend::kMinResiduals) return fallback;
+    return EpipolarTrend::fit(residuals, right_camera_.K()(0, 2), right_camera_.K()(0, 0));
   };
   // Pairs handed to the filter (tracked and new) are also checked for a depth discontinuity
   // across their patch (costly, so not every match is).
@@ -199,6 +229,7 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
 
   // 1. Tracking (Sec. II-C): windows from the filter's predictions and S.
   std::vector<StereoObservation> observations;
+  std::vector<RefinedPair> tracked_pairs;  // before the epipolar trend's check
   if (tracker_.size() > 0 && filter.pointCount() > 0) {
     last_windows_ =
         tracker_.windows(filter.predictObservations(motion), left_camera_, right_camera_);
@@ -242,15 +273,16 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
       }
       if (!anchored(m.id, &left_raw)) continue;
       const Eigen::Vector2d left_und = left_camera_.undistortPixel(left_raw);
-      Eigen::Vector2d right_raw, right_und;
-      if (!refine(left_raw, left_und, right.raw[static_cast<size_t>(m.right)], &right_raw,
-                  &right_und) ||
-          !continuous(left_raw, left_und, right_raw, right_und)) {
+      RefinedPair pair;
+      pair.id = m.id;
+      pair.left_raw = left_raw;
+      pair.left_und = left_und;
+      if (!refine(left_raw, left_und, right.raw[static_cast<size_t>(m.right)], &pair.right_raw,
+                  &pair.right_und, &pair.line) ||
+          !continuous(left_raw, left_und, pair.right_raw, pair.right_und)) {
         continue;
       }
-      tracker_.setLeftPixel(m.id, left_raw);
-      reanchorIfDeformed(m.id, left_raw);
-      observations.push_back(observation(m.id, left_raw, right_raw));
+      tracked_pairs.push_back(pair);
     }
   }
   // Tracks whose keypoint was not detected again (or not confirmed): the point's patch of
@@ -259,7 +291,7 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   // right image around the right prediction moved by the left innovation.
   if (config_.search_lost_tracks && !previous_left_.empty()) {
     std::unordered_set<PointId> observed;
-    for (const StereoObservation& o : observations) observed.insert(o.id);
+    for (const RefinedPair& pair : tracked_pairs) observed.insert(pair.id);
     for (const TrackWindow& w : last_windows_) {
       if (observed.count(w.id)) continue;
       Eigen::Vector2d previous;
@@ -294,20 +326,30 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
       const Eigen::Matrix2d r_cov = w.S.bottomRightCorner<2, 2>() - gain * S_rl.transpose();
       const Eigen::Vector2d r_guess = right_camera_.normalizedToPixel(
           (right_camera_.K().inverse() * r_mean.homogeneous()).head<2>());
-      Eigen::Vector2d right_raw, right_und;
-      if (!refine(left_raw, left_und, r_guess, &right_raw, &right_und) ||
-          !continuous(left_raw, left_und, right_raw, right_und)) {
+      RefinedPair pair;
+      pair.id = w.id;
+      pair.left_raw = left_raw;
+      pair.left_und = left_und;
+      if (!refine(left_raw, left_und, r_guess, &pair.right_raw, &pair.right_und, &pair.line) ||
+          !continuous(left_raw, left_und, pair.right_raw, pair.right_und)) {
         continue;
       }
-      const Eigen::Vector2d er = right_und - r_mean;
+      const Eigen::Vector2d er = pair.right_und - r_mean;
       if (!(r_cov.determinant() > 0.0) ||
           er.dot(r_cov.inverse() * er) > config_.track_gate_chi2_2dof) {
         continue;
       }
-      tracker_.setLeftPixel(w.id, left_raw);
-      reanchorIfDeformed(w.id, left_raw);
-      observations.push_back(observation(w.id, left_raw, right_raw));
+      tracked_pairs.push_back(pair);
     }
+  }
+  // The tracked pairs within their own noise of the frame's common distance from the lines
+  // (the last frame's where too few were tracked to fit one).
+  const EpipolarTrend tracked_trend = fitTrend({&tracked_pairs}, epipolar_trend_);
+  for (const RefinedPair& pair : tracked_pairs) {
+    if (!onTrend(tracked_trend, pair)) continue;
+    tracker_.setLeftPixel(pair.id, pair.left_raw);
+    reanchorIfDeformed(pair.id, pair.left_raw);
+    observations.push_back(observation(pair.id, pair.left_raw, pair.right_raw));
   }
   last_tracked_ = observations;
   stats.tracked = static_cast<int>(observations.size());
@@ -354,16 +396,28 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   std::vector<double> costs;
   std::vector<int> usable;
   std::vector<int> near;
+  std::vector<RefinedPair> matched_pairs;  // before the epipolar trend's check
   for (size_t k = 0; k < matches.size(); ++k) {
     const StereoMatch& m = matches[k];
-    const Eigen::Vector2d& pl = left.raw[static_cast<size_t>(m.left)];
-    const Eigen::Vector2d& ul = left.undistorted[static_cast<size_t>(m.left)];
-    if (!plausible(ul, right.undistorted[static_cast<size_t>(m.right)])) continue;
-    Eigen::Vector2d pr, ur;
-    if (!refine(pl, ul, right.raw[static_cast<size_t>(m.right)], &pr, &ur) || !plausible(ul, ur)) {
+    RefinedPair pair;
+    pair.match = static_cast<int>(k);
+    pair.left_raw = left.raw[static_cast<size_t>(m.left)];
+    pair.left_und = left.undistorted[static_cast<size_t>(m.left)];
+    if (!plausible(pair.left_und, right.undistorted[static_cast<size_t>(m.right)])) continue;
+    if (!refine(pair.left_raw, pair.left_und, right.raw[static_cast<size_t>(m.right)],
+                &pair.right_raw, &pair.right_und, &pair.line) ||
+        !plausible(pair.left_und, pair.right_und)) {
       continue;
     }
-    last_matches_.push_back(observation(0, pl, pr));
+    matched_pairs.push_back(pair);
+  }
+  // The frame's common distance from the lines, from every refined pair of the frame.
+  const EpipolarTrend trend = fitTrend({&tracked_pairs, &matched_pairs}, tracked_trend);
+  epipolar_trend_ = trend;
+  for (const RefinedPair& pair : matched_pairs) {
+    if (!onTrend(trend, pair)) continue;
+    const Eigen::Vector2d& pl = pair.left_raw;
+    last_matches_.push_back(observation(0, pl, pair.right_raw));
     near.clear();
     const Eigen::Vector2d r = Eigen::Vector2d::Constant(config_.min_distance_to_track);
     tracked_grid.query(pl - r, pl + r, &near);
@@ -373,10 +427,10 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
           (tracked_pixels[static_cast<size_t>(t)] - pl).norm() < config_.min_distance_to_track;
     }
     if (too_close) continue;
-    usable.push_back(static_cast<int>(k));
+    usable.push_back(pair.match);
     positions.push_back(pl);
-    right_positions.push_back(pr);
-    costs.push_back(m.descriptor_distance);
+    right_positions.push_back(pair.right_raw);
+    costs.push_back(matches[static_cast<size_t>(pair.match)].descriptor_distance);
   }
   stats.stereo_matches = static_cast<int>(last_matches_.size());
 
@@ -393,14 +447,15 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
                                                      config_.max_corner_shift, &at)) {
       return;
     }
-    const Eigen::Vector2d left_und = left_camera_.undistortPixel(at);
-    Eigen::Vector2d right_at, right_und;
-    if (!refine(at, left_und, *right_raw, &right_at, &right_und) ||
-        !plausible(left_und, right_und)) {
+    RefinedPair pair;
+    pair.left_raw = at;
+    pair.left_und = left_camera_.undistortPixel(at);
+    if (!refine(at, pair.left_und, *right_raw, &pair.right_raw, &pair.right_und, &pair.line) ||
+        !onTrend(trend, pair) || !plausible(pair.left_und, pair.right_und)) {
       return;
     }
     *left_raw = at;
-    *right_raw = right_at;
+    *right_raw = pair.right_raw;
   };
   for (int u : kept) {
     const StereoMatch& m = matches[static_cast<size_t>(usable[static_cast<size_t>(u)])];
@@ -494,6 +549,7 @@ void StereoFrontEnd::commit(const FrameReport& report, const CalibrationFilter& 
 
 void StereoFrontEnd::reset() {
   tracker_.clear();
+  epipolar_trend_ = EpipolarTrend();
   pending_.clear();
   previous_left_.release();
   current_left_.release();

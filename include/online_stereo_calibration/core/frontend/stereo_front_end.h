@@ -16,6 +16,7 @@
 #include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
 #include "online_stereo_calibration/core/estimator/types.h"
 #include "online_stereo_calibration/core/frontend/epipolar_matcher.h"
+#include "online_stereo_calibration/core/frontend/epipolar_trend.h"
 #include "online_stereo_calibration/core/frontend/feature_detection.h"
 #include "online_stereo_calibration/core/frontend/front_end_config.h"
 #include "online_stereo_calibration/core/frontend/point_tracker.h"
@@ -100,6 +101,9 @@ class StereoFrontEnd {
   std::vector<Pending> pending_;
   cv::Mat last_left_, last_right_;
   cv::Mat previous_left_, current_left_;  ///< copies: the left images of the last two pairs
+  /// The last pair's common epipolar distance of refined pairs, for a frame with too few
+  /// tracked pairs to fit its own.
+  EpipolarTrend epipolar_trend_;
   std::vector<StereoObservation> last_tracked_, last_new_, last_matches_;
   std::vector<TrackWindow> last_windows_;
   std::vector<EpipolarBand> last_bands_;
