@@ -2,6 +2,7 @@
 // motion), end to end through the estimator facade: accuracy against the seed's Table I,
 // honesty of the uncertainty, any mounting, and observability.
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -113,6 +114,56 @@ TEST(Observability, CameraHeightNeedsRollOrPitch) {
   FilterConfig measured_linearisation;
   measured_linearisation.motion_excitation_window = 0.0;
   EXPECT_LT(lastFrame(planar, 300, measured_linearisation).sigmas(2), 0.7 * initial_sigma);
+}
+
+/// The start of the EuRoC MAV drive at measurement level: a small rig (11 cm baseline,
+/// 460 px focal, 752x480, 20 Hz, points 1-8 m) hovering motionless, yr started 2 cm off.
+MeasurementScenario hoveringSmallRigScenario() {
+  MeasurementScenario s = paperOffroadScenario();
+  s.name = "hovering_small_rig";
+  s.rate_hz = 20.0;
+  s.step_frame = -1;
+  for (CameraIntrinsics* camera : {&s.left, &s.right}) {
+    camera->width = 752;
+    camera->height = 480;
+    camera->fx = camera->fy = 460.0;
+    camera->cx = 375.5;
+    camera->cy = 239.5;
+  }
+  s.truth.setZero();
+  s.truth(7) = -0.11;  // yr: the baseline
+  s.initial_error.setZero();
+  s.initial_error(7) = 0.02;
+  s.motion = VehicleMotionProfile();
+  s.motion.speed = 0.0;
+  s.motion.roll_amplitude = s.motion.pitch_amplitude = 0.0;
+  s.motion.yaw_rate_amplitude = s.motion.heave_amplitude = 0.0;
+  s.min_depth = 1.0;
+  s.max_depth = 8.0;
+  s.mean_track_length = std::numeric_limits<double>::infinity();
+  return s;
+}
+
+// Without translation the stereo baseline (yr) is a scale that no pixel shows: static points
+// at unknown depths look the same through any baseline. A hovering rig must stay about as
+// unsure of yr as its prior. DISABLED: it fails (an open problem, diagnostic for the MAV
+// drive): after 100 frames yr sigma is 1-3 mm and yr 5-40 sigma off, from (a) point
+// regressions B linearised at old means after each update (B_t t_r no longer = p, so
+// re-looks at a static point "measure" the baseline), (b) the prediction linearised at the
+// measured translation (noise, bilinear with depth) and (c) with a 2 deg x_camr rotation
+// prior, point depths +-100 % uncertain, so the UT of the first re-looks fakes yaw_r.
+TEST(Observability, DISABLED_HoveringSmallRigDoesNotLearnItsBaseline) {
+  for (const double rotation_sigma_deg : {0.2, 2.0}) {
+    FilterConfig config;
+    config.initial_camr_translation_sigma = 0.03;
+    config.initial_camr_rotation_sigma = rotation_sigma_deg * kDeg;
+    const ScenarioFrameResult r = lastFrame(hoveringSmallRigScenario(), 100, config);
+    const double error = r.parameters(7) - r.truth(7);
+    EXPECT_GT(r.sigmas(7), 0.5 * config.initial_camr_translation_sigma)
+        << "rotation prior " << rotation_sigma_deg << " deg";
+    EXPECT_LT(std::abs(error), 3.0 * r.sigmas(7))
+        << "rotation prior " << rotation_sigma_deg << " deg";
+  }
 }
 
 // Gross outliers (wrong matches) must not drag the calibration.
