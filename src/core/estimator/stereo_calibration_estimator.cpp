@@ -114,6 +114,11 @@ std::vector<PointId> StereoCalibrationEstimator::resetTracking() {
   return dropped;
 }
 
+std::vector<PointId> StereoCalibrationEstimator::reopenRightCameraRotation() {
+  has_previous_frame_ = false;
+  return filter_.reopen(JumpBlock::kLeftToRight, 0.0, config_.initial_camr_rotation_sigma);
+}
+
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
   filter_.reset(guess);
   has_previous_frame_ = false;

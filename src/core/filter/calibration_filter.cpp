@@ -578,14 +578,31 @@ bool CalibrationFilter::canReopen(JumpBlock block) const {
 }
 
 void CalibrationFilter::reopenBlock(JumpBlock block) {
+  widenBlock(block, config_.jump_translation_sigma, config_.jump_rotation_sigma);
+}
+
+std::vector<PointId> CalibrationFilter::reopen(JumpBlock block, double translation_sigma,
+                                               double rotation_sigma) {
+  std::vector<PointId> removed;
+  if (block == JumpBlock::kNone) return removed;
+  for (const TrackedPoint& point : points_) removed.push_back(point.id);
+  points_.clear();
+  index_.clear();
+  last_prediction_.reset();
+  widenBlock(block, translation_sigma, rotation_sigma);
+  return removed;
+}
+
+void CalibrationFilter::widenBlock(JumpBlock block, double translation_sigma,
+                                   double rotation_sigma) {
   if (block == JumpBlock::kNone) return;
   const int first = block == JumpBlock::kVehicleToLeft ? layout::kCaml : layout::kCamr;
   Vector6d variance = covariance_.diagonal().segment<6>(first);
   for (int k = 0; k < 3; ++k) {
     variance(layout::kTranslation + k) =
-        std::max(variance(layout::kTranslation + k), std::pow(config_.jump_translation_sigma, 2));
+        std::max(variance(layout::kTranslation + k), std::pow(translation_sigma, 2));
     variance(layout::kRotation + k) =
-        std::max(variance(layout::kRotation + k), std::pow(config_.jump_rotation_sigma, 2));
+        std::max(variance(layout::kRotation + k), std::pow(rotation_sigma, 2));
   }
   // Decorrelate the re-opened block from the rest: its old correlations no longer hold.
   covariance_.middleRows<6>(first).setZero();

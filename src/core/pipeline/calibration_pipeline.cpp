@@ -62,22 +62,46 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   result.processed = true;
   result.status =
       result.estimator.motion_rejected ? "processed (motion rejected, tracks reset)" : "ok";
+  if (lostTheStereoGeometry(result.front_end)) {
+    // A knocked right camera moves every right pixel out of the epipolar band of a converged
+    // x_camr: no pair reaches the filter, so its own jump test never sees one. Re-opening
+    // x_camr's rotation widens the band to its start-up width, and the filter re-converges.
+    estimator_->reopenRightCameraRotation();
+    front_end_->reset();
+    pairs_without_stereo_ = 0;
+    result.right_camera_reopened = true;
+    result.status =
+        "no stereo pair in 2 pairs with features in both images: x_camr's rotation re-opened "
+        "(a knocked right camera?), tracking restarted";
+  }
   result.estimate = estimator_->estimate();
   result.processing_time =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 
+bool CalibrationPipeline::lostTheStereoGeometry(const FrontEndStatistics& stats) {
+  constexpr int kMinFeatures = 200;         // per image: enough texture to expect pairs
+  constexpr int kMaxPairs = 5;              // tracked + new stereo matches: "none"
+  constexpr int kPairsBeforeReopening = 2;  // one pair may be a glitch (blur, occlusion)
+  const bool textured = stats.features_left >= kMinFeatures && stats.features_right >= kMinFeatures;
+  const bool none = stats.tracked + stats.stereo_matches <= kMaxPairs;
+  pairs_without_stereo_ = textured && none ? pairs_without_stereo_ + 1 : 0;
+  return pairs_without_stereo_ >= kPairsBeforeReopening;
+}
+
 void CalibrationPipeline::resetTracking() {
   estimator_->resetTracking();
   front_end_->reset();
   has_pending_motion_ = false;
+  pairs_without_stereo_ = 0;
 }
 
 void CalibrationPipeline::reset(const StereoExtrinsics& guess) {
   estimator_->reset(guess);
   front_end_->reset();
   has_pending_motion_ = false;
+  pairs_without_stereo_ = 0;
 }
 
 void CalibrationPipeline::reset(const StereoExtrinsics& guess,
@@ -85,6 +109,7 @@ void CalibrationPipeline::reset(const StereoExtrinsics& guess,
   estimator_->reset(guess, tangent_covariance);
   front_end_->reset();
   has_pending_motion_ = false;
+  pairs_without_stereo_ = 0;
 }
 
 CalibrationEstimate CalibrationPipeline::estimate() const { return estimator_->estimate(); }

@@ -98,6 +98,11 @@ class CalibrationFilter {
   bool addPoint(const PointMeasurement& measurement);
   void removePoint(PointId id);
   bool hasPoint(PointId id) const { return index_.count(id) > 0; }
+  /// A sudden change of one camera's mounting found outside the filter (the front end finds
+  /// no stereo pair any more, CalibrationPipeline): the block's uncertainty is widened to at
+  /// least the given sigmas and decorrelated from the rest, and every point is removed (their
+  /// regressions on the block no longer hold). Returns the removed points' ids.
+  std::vector<PointId> reopen(JumpBlock block, double translation_sigma, double rotation_sigma);
   size_t pointCount() const { return points_.size(); }
 
   const StereoExtrinsics& extrinsics() const { return extrinsics_; }
@@ -146,7 +151,9 @@ class CalibrationFilter {
                      std::vector<bool>* failed);
   void marginalizeMotionError(const Eigen::MatrixXd& P_global);
   bool canReopen(JumpBlock block) const;
+  /// widenBlock with the config's jump sigmas (the points are the caller's).
   void reopenBlock(JumpBlock block);
+  void widenBlock(JumpBlock block, double translation_sigma, double rotation_sigma);
   void removeIndices(const std::vector<bool>& remove);
   bool repairCovariance();
   void rebuildIndex();

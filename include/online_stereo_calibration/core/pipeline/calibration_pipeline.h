@@ -20,12 +20,12 @@ class StereoFrontEnd;
 
 /// Counts of what the front end did with one image pair.
 struct FrontEndStatistics {
-  int features_left = 0;      ///< keypoints detected in the left image
-  int features_right = 0;     ///< keypoints detected in the right image
-  int stereo_matches = 0;     ///< epipolar-guided matches before bucketing
-  int new_candidates = 0;     ///< matches kept by bucketing and offered as new points
-  int tracked = 0;            ///< tracked points found again in both images
-  int track_failures = 0;     ///< tracked points not found (then removed, Sec. II-C)
+  int features_left = 0;   ///< keypoints detected in the left image
+  int features_right = 0;  ///< keypoints detected in the right image
+  int stereo_matches = 0;  ///< epipolar-guided matches before bucketing
+  int new_candidates = 0;  ///< matches kept by bucketing and offered as new points
+  int tracked = 0;         ///< tracked points found again in both images
+  int track_failures = 0;  ///< tracked points not found (then removed, Sec. II-C)
 };
 
 /// What processing one image pair produced.
@@ -34,10 +34,13 @@ struct PipelineResult {
   /// the estimator is then untouched and status says why.
   bool processed = false;
   std::string status;
-  FrameReport estimator;        ///< the estimator's report (valid if processed)
+  FrameReport estimator;  ///< the estimator's report (valid if processed)
   FrontEndStatistics front_end;
-  CalibrationEstimate estimate; ///< the estimate after this pair
-  double processing_time = 0.0; ///< seconds spent on this pair (front end + filter)
+  CalibrationEstimate estimate;  ///< the estimate after this pair
+  /// No stereo pair found in this and the previous pair although both images had features:
+  /// x_camr's rotation was re-opened and tracking restarted (a knocked right camera).
+  bool right_camera_reopened = false;
+  double processing_time = 0.0;  ///< seconds spent on this pair (front end + filter)
 };
 
 /// The image pipeline. Not thread-safe: call from one thread.
@@ -75,12 +78,18 @@ class CalibrationPipeline {
   const StereoFrontEnd& frontEnd() const;
 
  private:
+  /// Counts pairs in which no stereo pair was found although both images had features; true
+  /// (a knocked right camera) from the second in a row.
+  bool lostTheStereoGeometry(const FrontEndStatistics& stats);
+
   std::unique_ptr<StereoCalibrationEstimator> estimator_;
   std::unique_ptr<StereoFrontEnd> front_end_;
   /// Motion of skipped (unusable) pairs since the last processed one, composed.
   MotionIncrement pending_motion_;
   bool has_pending_motion_ = false;
   bool processed_any_ = false;
+  /// Consecutive processed pairs without a stereo pair although both images had features.
+  int pairs_without_stereo_ = 0;
 };
 
 }  // namespace osc
