@@ -384,7 +384,12 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
   for (const std::string& warning : result.estimator.warnings) {
     NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: %s", warning.c_str());
   }
-  const bool jump = result.estimator.step.jump != osc::JumpBlock::kNone;
+  if (result.right_camera_reopened) {
+    NODELET_WARN("online_stereo_calibration: %s", result.status.c_str());
+  }
+  // A change found by the filter's jump test, or by the pipeline when no stereo pair is left.
+  const bool jump =
+      result.estimator.step.jump != osc::JumpBlock::kNone || result.right_camera_reopened;
   const uint8_t state = calibrationState(result.estimate, jump, config_.ros.min_tracked_points,
                                          config_.ros.converged_translation_3sigma,
                                          config_.ros.converged_rotation_3sigma);
