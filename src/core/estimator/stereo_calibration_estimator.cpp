@@ -114,9 +114,9 @@ std::vector<PointId> StereoCalibrationEstimator::resetTracking() {
   return dropped;
 }
 
-std::vector<PointId> StereoCalibrationEstimator::reopenRightCameraRotation() {
+std::vector<PointId> StereoCalibrationEstimator::reopenRightCameraRotation(double rotation_sigma) {
   has_previous_frame_ = false;
-  return filter_.reopen(JumpBlock::kLeftToRight, 0.0, config_.initial_camr_rotation_sigma);
+  return filter_.reopen(JumpBlock::kLeftToRight, 0.0, rotation_sigma);
 }
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {

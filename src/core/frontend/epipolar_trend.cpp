@@ -54,8 +54,10 @@ EpipolarTrend EpipolarTrend::fit(const std::vector<EpipolarResidual>& residuals,
   double squared = 0.0;
   for (const EpipolarResidual& r : residuals)
     squared += std::pow(c.dot(trend.regressors(r.right_pixel)), 2);
-  if (std::sqrt(squared / static_cast<double>(residuals.size())) < kMinDistance) return trend;
+  const double rms = std::sqrt(squared / static_cast<double>(residuals.size()));
+  if (rms < kMinDistance) return trend;
   trend.coefficients_ = c;
+  trend.rms_ = rms;
   return trend;
 }
 

@@ -1,7 +1,10 @@
 #include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
 
 #include <chrono>
+#include <cmath>
+#include <string>
 
+#include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/frontend/feature_detection.h"
 #include "online_stereo_calibration/core/frontend/stereo_front_end.h"
 
@@ -62,17 +65,27 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   result.processed = true;
   result.status =
       result.estimator.motion_rejected ? "processed (motion rejected, tracks reset)" : "ok";
+  // A knocked right camera. Beyond the epipolar band of a converged x_camr no pair reaches
+  // the filter, so its own jump test never sees one; within it the pairs reach it but, off
+  // their lines by tens of its sigmas, are followed only through x_camr's slow drift noise.
+  // Re-opening x_camr's rotation widens the band and lets the filter re-converge at once.
+  double rotation_sigma = 0.0;
+  std::string why;
   if (lostTheStereoGeometry(result.front_end)) {
-    // A knocked right camera moves every right pixel out of the epipolar band of a converged
-    // x_camr: no pair reaches the filter, so its own jump test never sees one. Re-opening
-    // x_camr's rotation widens the band to its start-up width, and the filter re-converges.
-    estimator_->reopenRightCameraRotation();
+    rotation_sigma = estimator_->filter().config().initial_camr_rotation_sigma;
+    why = "no stereo pair in 2 pairs with features in both images";
+  } else if (rightCameraMoved(&rotation_sigma)) {
+    why = "the stereo pairs of 2 pairs off their epipolar lines by " +
+          std::to_string(front_end_->lastEpipolarTrend().rms()) + " px";
+  }
+  if (!why.empty()) {
+    estimator_->reopenRightCameraRotation(rotation_sigma);
     front_end_->reset();
-    pairs_without_stereo_ = 0;
+    pairs_without_stereo_ = pairs_off_their_lines_ = 0;
     result.right_camera_reopened = true;
-    result.status =
-        "no stereo pair in 2 pairs with features in both images: x_camr's rotation re-opened "
-        "(a knocked right camera?), tracking restarted";
+    result.status = why +
+                    ": x_camr's rotation re-opened (a knocked right camera?), tracking "
+                    "restarted";
   }
   result.estimate = estimator_->estimate();
   result.processing_time =
@@ -90,18 +103,36 @@ bool CalibrationPipeline::lostTheStereoGeometry(const FrontEndStatistics& stats)
   return pairs_without_stereo_ >= kPairsBeforeReopening;
 }
 
+bool CalibrationPipeline::rightCameraMoved(double* rotation_sigma) {
+  constexpr double kMinDistance = 0.3;  // px: three times a refined pair's own noise
+  constexpr double kKnockSigmas = 5.0;
+  constexpr int kPairsBeforeReopening = 2;
+  const double focal = estimator_->rightCamera().K()(0, 0);
+  const double angle = front_end_->lastEpipolarTrend().rms() / focal;  // rad, small-angle
+  const double sigma = std::sqrt(estimator_->filter()
+                                     .covariance()
+                                     .diagonal()
+                                     .segment<3>(layout::kCamr + layout::kRotation)
+                                     .maxCoeff());
+  const bool moved =
+      front_end_->lastEpipolarTrend().rms() >= kMinDistance && angle > kKnockSigmas * sigma;
+  pairs_off_their_lines_ = moved ? pairs_off_their_lines_ + 1 : 0;
+  *rotation_sigma = 3.0 * angle;
+  return pairs_off_their_lines_ >= kPairsBeforeReopening;
+}
+
 void CalibrationPipeline::resetTracking() {
   estimator_->resetTracking();
   front_end_->reset();
   has_pending_motion_ = false;
-  pairs_without_stereo_ = 0;
+  pairs_without_stereo_ = pairs_off_their_lines_ = 0;
 }
 
 void CalibrationPipeline::reset(const StereoExtrinsics& guess) {
   estimator_->reset(guess);
   front_end_->reset();
   has_pending_motion_ = false;
-  pairs_without_stereo_ = 0;
+  pairs_without_stereo_ = pairs_off_their_lines_ = 0;
 }
 
 void CalibrationPipeline::reset(const StereoExtrinsics& guess,
@@ -109,7 +140,7 @@ void CalibrationPipeline::reset(const StereoExtrinsics& guess,
   estimator_->reset(guess, tangent_covariance);
   front_end_->reset();
   has_pending_motion_ = false;
-  pairs_without_stereo_ = 0;
+  pairs_without_stereo_ = pairs_off_their_lines_ = 0;
 }
 
 CalibrationEstimate CalibrationPipeline::estimate() const { return estimator_->estimate(); }

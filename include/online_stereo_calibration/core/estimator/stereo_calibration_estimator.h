@@ -56,10 +56,10 @@ class StereoCalibrationEstimator {
 
   /// Forgets every tracked point (e.g. time jumped back); the calibration is kept.
   std::vector<PointId> resetTracking();
-  /// The right camera was knocked (no stereo pair is found any more): x_camr's rotation
-  /// uncertainty is re-opened to the config's initial sigma (its translation kept: a knock
-  /// turns a camera) and every point is forgotten. Returns the forgotten points.
-  std::vector<PointId> reopenRightCameraRotation();
+  /// The right camera was knocked (CalibrationPipeline): x_camr's rotation uncertainty is
+  /// re-opened to at least `rotation_sigma` (rad; its translation kept: a knock turns a
+  /// camera) and every point is forgotten. Returns the forgotten points.
+  std::vector<PointId> reopenRightCameraRotation(double rotation_sigma);
   /// Starts over from a new guess with the config's initial uncertainty.
   void reset(const StereoExtrinsics& guess);
   /// Starts over from a saved calibration with its covariance (tangent, see filter).

@@ -41,6 +41,9 @@ class EpipolarTrend {
   double at(const Eigen::Vector2d& right_pixel) const;
   /// c0, c1 (px).
   const Eigen::Vector2d& coefficients() const { return coefficients_; }
+  /// Root mean square of the fitted distance over the pairs it was fitted to (px; 0 for no
+  /// trend): how far off its lines the frame's geometry is.
+  double rms() const { return rms_; }
 
   static constexpr int kMinResiduals = 12;
   static constexpr double kMinDistance = 0.1;
@@ -49,6 +52,7 @@ class EpipolarTrend {
   Eigen::Vector2d regressors(const Eigen::Vector2d& right_pixel) const;
 
   Eigen::Vector2d coefficients_ = Eigen::Vector2d::Zero();
+  double rms_ = 0.0;
   double center_column_ = 0.0;
   double focal_ = 1.0;
 };

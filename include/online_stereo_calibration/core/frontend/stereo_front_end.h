@@ -58,6 +58,8 @@ class StereoFrontEnd {
   const std::vector<StereoObservation>& lastStereoMatches() const { return last_matches_; }
   /// Search windows of the last pair.
   const std::vector<TrackWindow>& lastWindows() const { return last_windows_; }
+  /// The last pair's common distance of refined pairs from their epipolar lines.
+  const EpipolarTrend& lastEpipolarTrend() const { return epipolar_trend_; }
   /// Points being tracked.
   size_t trackCount() const { return tracker_.size(); }
 

@@ -37,8 +37,9 @@ struct PipelineResult {
   FrameReport estimator;  ///< the estimator's report (valid if processed)
   FrontEndStatistics front_end;
   CalibrationEstimate estimate;  ///< the estimate after this pair
-  /// No stereo pair found in this and the previous pair although both images had features:
-  /// x_camr's rotation was re-opened and tracking restarted (a knocked right camera).
+  /// A knocked right camera: no stereo pair found in this and the previous pair although
+  /// both images had features, or the refined pairs of both off their epipolar lines by far
+  /// more than x_camr's sigma allows. x_camr's rotation was re-opened and tracking restarted.
   bool right_camera_reopened = false;
   double processing_time = 0.0;  ///< seconds spent on this pair (front end + filter)
 };
@@ -81,6 +82,10 @@ class CalibrationPipeline {
   /// Counts pairs in which no stereo pair was found although both images had features; true
   /// (a knocked right camera) from the second in a row.
   bool lostTheStereoGeometry(const FrontEndStatistics& stats);
+  /// Counts pairs whose refined pairs lie off their epipolar lines (EpipolarTrend) by an angle
+  /// of more than kKnockSigmas x_camr rotation sigmas; true from the second in a row, with
+  /// the rotation sigma that distance calls for.
+  bool rightCameraMoved(double* rotation_sigma);
 
   std::unique_ptr<StereoCalibrationEstimator> estimator_;
   std::unique_ptr<StereoFrontEnd> front_end_;
@@ -90,6 +95,8 @@ class CalibrationPipeline {
   bool processed_any_ = false;
   /// Consecutive processed pairs without a stereo pair although both images had features.
   int pairs_without_stereo_ = 0;
+  /// Consecutive processed pairs whose refined pairs lay off their lines (rightCameraMoved).
+  int pairs_off_their_lines_ = 0;
 };
 
 }  // namespace osc
