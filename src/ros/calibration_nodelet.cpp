@@ -387,7 +387,7 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
   if (result.right_camera_reopened) {
     NODELET_WARN("online_stereo_calibration: %s", result.status.c_str());
   }
-  // A change found by the filter's jump test, or by the pipeline when no stereo pair is left.
+  // A change found by the filter's jump test, or by the pipeline (a knocked right camera).
   const bool jump =
       result.estimator.step.jump != osc::JumpBlock::kNone || result.right_camera_reopened;
   const uint8_t state = calibrationState(result.estimate, jump, config_.ros.min_tracked_points,

@@ -801,7 +801,10 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
             }
           }
           showCrop(r.filter.frame, o, pl, pr);
-          if (std::getenv("D_INNOV")) {  // the track's innovation against the filter's prediction
+          const bool off_birth = !(vl && vr && el <= 1.5 && er <= 1.5);
+          // The track's innovation against the filter's prediction (undistorted pixels: the
+          // reported raw ones are the same on the pinhole drives only).
+          if (std::getenv("D_INNOV")) {
             for (const TrackWindow& w : pipeline.frontEnd().lastWindows()) {
               if (w.id != o.id) continue;
               const Eigen::Vector4d z(o.left_pixel.x(), o.left_pixel.y(), o.right_pixel.x(),
@@ -811,12 +814,11 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
                   "I id %lu frame %d age %d bad %d e %.2f %.2f %.2f %.2f nis %.2f sd %.2f %.2f "
                   "%.2f %.2f\n",
                   (unsigned long)o.id, r.filter.frame, r.filter.frame - it->second.second,
-                  !(vl && vr && el <= 1.5 && er <= 1.5), e(0), e(1), e(2), e(3),
-                  e.dot(w.S.inverse() * e), std::sqrt(w.S(0, 0)), std::sqrt(w.S(1, 1)),
-                  std::sqrt(w.S(2, 2)), std::sqrt(w.S(3, 3)));
+                  off_birth, e(0), e(1), e(2), e(3), e.dot(w.S.inverse() * e), std::sqrt(w.S(0, 0)),
+                  std::sqrt(w.S(1, 1)), std::sqrt(w.S(2, 2)), std::sqrt(w.S(3, 3)));
             }
           }
-          if (!(vl && vr && el <= 1.5 && er <= 1.5) && !quiet)
+          if (off_birth && !quiet)
             std::printf(
                 "B id %lu age %d vis %d%d L(%.0f,%.0f) errL %.2f (%.2f,%.2f) errR %.2f depth %.1f "
                 "edgeL %.2f\n",

@@ -9,6 +9,13 @@
 #include "online_stereo_calibration/core/frontend/stereo_front_end.h"
 
 namespace osc {
+namespace {
+
+/// Pairs in a row that must show a knocked right camera before x_camr is re-opened: one pair
+/// may be a glitch (blur, an occlusion, a bad exposure).
+constexpr int kKnockedPairsBeforeReopening = 2;
+
+}  // namespace
 
 CalibrationPipeline::CalibrationPipeline(const FilterConfig& filter_config,
                                          const FrontEndConfig& front_end_config,
@@ -80,8 +87,7 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   }
   if (!why.empty()) {
     estimator_->reopenRightCameraRotation(rotation_sigma);
-    front_end_->reset();
-    pairs_without_stereo_ = pairs_off_their_lines_ = 0;
+    restartFrontEnd();
     result.right_camera_reopened = true;
     result.status = why +
                     ": x_camr's rotation re-opened (a knocked right camera?), tracking "
@@ -94,19 +100,17 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
 }
 
 bool CalibrationPipeline::lostTheStereoGeometry(const FrontEndStatistics& stats) {
-  constexpr int kMinFeatures = 200;         // per image: enough texture to expect pairs
-  constexpr int kMaxPairs = 5;              // tracked + new stereo matches: "none"
-  constexpr int kPairsBeforeReopening = 2;  // one pair may be a glitch (blur, occlusion)
+  constexpr int kMinFeatures = 200;  // per image: enough texture to expect pairs
+  constexpr int kMaxPairs = 5;       // tracked + new stereo matches: "none"
   const bool textured = stats.features_left >= kMinFeatures && stats.features_right >= kMinFeatures;
   const bool none = stats.tracked + stats.stereo_matches <= kMaxPairs;
   pairs_without_stereo_ = textured && none ? pairs_without_stereo_ + 1 : 0;
-  return pairs_without_stereo_ >= kPairsBeforeReopening;
+  return pairs_without_stereo_ >= kKnockedPairsBeforeReopening;
 }
 
 bool CalibrationPipeline::rightCameraMoved(double* rotation_sigma) {
   constexpr double kMinDistance = 0.3;  // px: three times a refined pair's own noise
   constexpr double kKnockSigmas = 5.0;
-  constexpr int kPairsBeforeReopening = 2;
   const double focal = estimator_->rightCamera().K()(0, 0);
   const double angle = front_end_->lastEpipolarTrend().rms() / focal;  // rad, small-angle
   const double sigma = std::sqrt(estimator_->filter()
@@ -118,29 +122,29 @@ bool CalibrationPipeline::rightCameraMoved(double* rotation_sigma) {
       front_end_->lastEpipolarTrend().rms() >= kMinDistance && angle > kKnockSigmas * sigma;
   pairs_off_their_lines_ = moved ? pairs_off_their_lines_ + 1 : 0;
   *rotation_sigma = 3.0 * angle;
-  return pairs_off_their_lines_ >= kPairsBeforeReopening;
+  return pairs_off_their_lines_ >= kKnockedPairsBeforeReopening;
+}
+
+void CalibrationPipeline::restartFrontEnd() {
+  front_end_->reset();
+  has_pending_motion_ = false;
+  pairs_without_stereo_ = pairs_off_their_lines_ = 0;
 }
 
 void CalibrationPipeline::resetTracking() {
   estimator_->resetTracking();
-  front_end_->reset();
-  has_pending_motion_ = false;
-  pairs_without_stereo_ = pairs_off_their_lines_ = 0;
+  restartFrontEnd();
 }
 
 void CalibrationPipeline::reset(const StereoExtrinsics& guess) {
   estimator_->reset(guess);
-  front_end_->reset();
-  has_pending_motion_ = false;
-  pairs_without_stereo_ = pairs_off_their_lines_ = 0;
+  restartFrontEnd();
 }
 
 void CalibrationPipeline::reset(const StereoExtrinsics& guess,
                                 const Matrix12d& tangent_covariance) {
   estimator_->reset(guess, tangent_covariance);
-  front_end_->reset();
-  has_pending_motion_ = false;
-  pairs_without_stereo_ = pairs_off_their_lines_ = 0;
+  restartFrontEnd();
 }
 
 CalibrationEstimate CalibrationPipeline::estimate() const { return estimator_->estimate(); }

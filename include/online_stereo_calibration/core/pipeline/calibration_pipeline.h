@@ -79,6 +79,9 @@ class CalibrationPipeline {
   const StereoFrontEnd& frontEnd() const;
 
  private:
+  /// Forgets the front end's tracks and the counts below (the estimator's points are the
+  /// caller's to drop).
+  void restartFrontEnd();
   /// Counts pairs in which no stereo pair was found although both images had features; true
   /// (a knocked right camera) from the second in a row.
   bool lostTheStereoGeometry(const FrontEndStatistics& stats);
