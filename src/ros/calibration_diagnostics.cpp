@@ -110,7 +110,24 @@ void CalibrationDiagnostics::recordEstimate(const osc::CalibrationEstimate& esti
   have_estimate_ = true;
 }
 
-void CalibrationDiagnostics::update() { updater_.update(); }
+void CalibrationDiagnostics::recordReset() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++resets_;
+  have_estimate_ = false;
+}
+
+void CalibrationDiagnostics::update() {
+  // diagnostic_updater::Updater::update() stays silent until the report time it computed
+  // before the clock went back (issue 17: 200 s without a status in a looped bag);
+  // force_update() reports now and schedules the next report from the new time.
+  const ros::Time now = ros::Time::now();
+  if (now < last_update_) {
+    updater_.force_update();
+  } else {
+    updater_.update();
+  }
+  last_update_ = now;
+}
 
 void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -155,9 +172,11 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
   }
   inputs_at_last_report_ = inputs_;
 
+  if (resets_ > 0) status.add("resets (total)", resets_);
   if (!have_estimate_) {
     level = std::max<unsigned char>(level, DiagnosticStatus::WARN);
-    reasons.push_back("no image pair processed yet");
+    reasons.push_back(resets_ > 0 ? "no image pair processed since ~reset"
+                                  : "no image pair processed yet");
   } else {
     status.add("state", stateName(state_));
     status.add("tracked points", estimate_.tracked_points);

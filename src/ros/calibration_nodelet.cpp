@@ -22,12 +22,17 @@ cv_bridge::CvImageConstPtr toPipelineImage(const sensor_msgs::ImageConstPtr& ima
   namespace enc = sensor_msgs::image_encodings;
   try {
     const std::string& e = image->encoding;
-    if (e == enc::MONO8 || e == enc::MONO16 || e == enc::BGR8 || e == enc::BGRA8) {
-      return cv_bridge::toCvShare(image);
+    const bool supported = e == enc::MONO8 || e == enc::MONO16 || e == enc::BGR8 ||
+                           e == enc::BGRA8 || e == enc::RGB8 || e == enc::RGBA8;
+    if (!supported) {
+      *error = "unsupported image encoding '" + e + "'";
+      return nullptr;
     }
+    *error = imageBufferProblem(*image, enc::numChannels(e) * enc::bitDepth(e) / 8);
+    if (!error->empty()) return nullptr;
     if (e == enc::RGB8) return cv_bridge::toCvShare(image, enc::BGR8);
     if (e == enc::RGBA8) return cv_bridge::toCvShare(image, enc::BGRA8);
-    *error = "unsupported image encoding '" + e + "'";
+    return cv_bridge::toCvShare(image);
   } catch (const cv_bridge::Exception& exception) {
     *error = std::string("cv_bridge: ") + exception.what();
   }
@@ -217,7 +222,8 @@ void CalibrationNodelet::workerLoop() {
   }
 }
 
-bool CalibrationNodelet::preparePipeline(const StereoPair& pair) {
+bool CalibrationNodelet::preparePipeline(const StereoPair& pair, const cv::Mat& left_image,
+                                         const cv::Mat& right_image) {
   osc::CameraIntrinsics left, right;
   try {
     left = intrinsicsFromCameraInfo(*pair.left_info);
@@ -239,6 +245,22 @@ bool CalibrationNodelet::preparePipeline(const StereoPair& pair) {
                           "camera_info differ in size or model",
                           left.width, left.height, osc::distortionModelName(left.model).c_str(),
                           right.width, right.height, osc::distortionModelName(right.model).c_str());
+  }
+  // A camera_info that does not describe its own image is bad input, not a new camera: refuse
+  // the pair before it could restart the pipeline.
+  const auto describes = [this](const osc::CameraIntrinsics& info, const cv::Mat& image,
+                                const std::string& side) {
+    if (image.cols == info.width && image.rows == info.height) return true;
+    const std::string problem = side + " image " + std::to_string(image.cols) + "x" +
+                                std::to_string(image.rows) + " does not match its camera_info (" +
+                                std::to_string(info.width) + "x" + std::to_string(info.height) +
+                                ")";
+    diagnostics_->recordProblem("rejected images", problem);
+    NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: pair skipped: %s", problem.c_str());
+    return false;
+  };
+  if (!describes(left, left_image, "left") || !describes(right, right_image, "right")) {
+    return false;
   }
   if (pipeline_ && !intrinsicsDiffer(left, left_intrinsics_) &&
       !intrinsicsDiffer(right, right_intrinsics_)) {
@@ -297,6 +319,22 @@ bool CalibrationNodelet::waitForMotion(const ros::Time& stamp, osc::MotionIncrem
       status = motion_->poseAvailable(stamp);
     } else {
       status = motion_->motionBetween(last_stamp_, stamp, motion);
+      const bool previous_lost = status == LookupStatus::kTooOld || status == LookupStatus::kGap;
+      if (previous_lost && motion_->poseAvailable(stamp) == LookupStatus::kOk) {
+        // The last processed pair's pose is gone (a pause longer than motion_history, the
+        // clock jumping forward): the motion since then can never be known. Start tracking
+        // afresh from this pair instead of skipping every pair from now on.
+        const std::string problem = "no motion from the last processed pair at " +
+                                    std::to_string(last_stamp_.toSec()) + " to " +
+                                    std::to_string(stamp.toSec()) + " (" +
+                                    lookupStatusName(status) + "): tracks reset";
+        diagnostics_->recordProblem("motion missing or late", problem);
+        NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: %s", problem.c_str());
+        std::lock_guard<std::mutex> lock(pipeline_mutex_);
+        pipeline_->resetTracking();
+        last_stamp_ = ros::Time();
+        return true;  // a first pair: its motion is not used
+      }
     }
     if (status == LookupStatus::kOk) return true;
     const bool may_come = status == LookupStatus::kNotYet || status == LookupStatus::kEmpty;
@@ -343,11 +381,9 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
     }
     // Odometry that already jumped back itself (a bag loop) is kept; a history that holds
     // only later stamps cannot serve the new time line.
-    if (motion_->poseAvailable(stamp) == LookupStatus::kTooOld) motion_->clear();
+    if (motion_->poseAvailable(stamp) == LookupStatus::kTooOld) motion_->restart();
     last_stamp_ = ros::Time();
   }
-  if (!preparePipeline(pair)) return;
-
   std::string error;
   cv_bridge::CvImageConstPtr left = toPipelineImage(pair.left, &error);
   cv_bridge::CvImageConstPtr right = left ? toPipelineImage(pair.right, &error) : nullptr;
@@ -356,6 +392,7 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
     NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: pair skipped: %s", error.c_str());
     return;
   }
+  if (!preparePipeline(pair, left->image, right->image)) return;
   osc::MotionIncrement motion;
   if (!waitForMotion(stamp, &motion)) return;
 
@@ -371,6 +408,8 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
     }
   }
   if (!result.processed) {
+    // last_stamp_ stays: the next pair's motion spans from the last processed pair
+    // (CalibrationPipeline::process), so the refused pair's motion is not counted twice.
     diagnostics_->recordProblem("rejected images", result.status);
     NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: pair skipped: %s",
                           result.status.c_str());
@@ -424,6 +463,7 @@ bool CalibrationNodelet::resetService(std_srvs::Trigger::Request&,
     }
   }
   last_estimate_.reset();
+  diagnostics_->recordReset();
   response.success = true;
   response.message = "calibration reset to the initial guess";
   NODELET_INFO("online_stereo_calibration: %s", response.message.c_str());

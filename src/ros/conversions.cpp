@@ -45,6 +45,20 @@ osc::Matrix12d tangentCovarianceFromParameterCovariance(
   return 0.5 * (tangent + tangent.transpose());
 }
 
+std::string imageBufferProblem(const sensor_msgs::Image& image, int bytes_per_pixel) {
+  const uint64_t row = static_cast<uint64_t>(image.width) * static_cast<uint64_t>(bytes_per_pixel);
+  const uint64_t needed = static_cast<uint64_t>(image.step) * image.height;
+  if (image.step < row) {
+    return "image step " + std::to_string(image.step) + " shorter than a row of " +
+           std::to_string(image.width) + " px x " + std::to_string(bytes_per_pixel) + " bytes";
+  }
+  if (image.data.size() < needed) {
+    return "image data of " + std::to_string(image.data.size()) + " bytes shorter than step x " +
+           "height (" + std::to_string(image.step) + " x " + std::to_string(image.height) + ")";
+  }
+  return "";
+}
+
 bool intrinsicsDiffer(const osc::CameraIntrinsics& a, const osc::CameraIntrinsics& b) {
   return a.width != b.width || a.height != b.height || a.fx != b.fx || a.fy != b.fy ||
          a.cx != b.cx || a.cy != b.cy || a.model != b.model || a.distortion != b.distortion;
@@ -83,17 +97,22 @@ geometry_msgs::Transform transformFromIsometry(const Eigen::Isometry3d& pose) {
   return transform;
 }
 
-bool isFinitePose(const geometry_msgs::Pose& pose) {
+std::string poseProblem(const geometry_msgs::Pose& pose) {
   const double values[] = {pose.position.x,    pose.position.y,    pose.position.z,
                            pose.orientation.w, pose.orientation.x, pose.orientation.y,
                            pose.orientation.z};
   for (double v : values) {
-    if (!std::isfinite(v)) return false;
+    if (!std::isfinite(v)) return "a non-finite pose";
   }
   const double norm2 =
       pose.orientation.w * pose.orientation.w + pose.orientation.x * pose.orientation.x +
       pose.orientation.y * pose.orientation.y + pose.orientation.z * pose.orientation.z;
-  return norm2 > 0.25 && norm2 < 4.0;
+  // Normalising anything between half and twice unit length is a harmless convention
+  // difference; a zero (or near-zero) quaternion is no rotation at all.
+  if (!(norm2 > 0.25 && norm2 < 4.0)) {
+    return "a quaternion of norm " + std::to_string(std::sqrt(norm2)) + " (not a rotation)";
+  }
+  return "";
 }
 
 Eigen::Isometry3d interpolatePose(const StampedPose& before, const StampedPose& after,

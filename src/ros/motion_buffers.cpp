@@ -33,6 +33,27 @@ bool PoseBuffer::add(const StampedPose& sample) {
   return true;
 }
 
+PoseBuffer::Offered PoseBuffer::offer(const StampedPose& sample) {
+  if (!std::isfinite(sample.stamp) || !sample.pose.matrix().allFinite()) return Offered::kRejected;
+  if (samples_.empty() || sample.stamp >= samples_.back().stamp - max_gap_) {
+    if (!add(sample)) return Offered::kRejected;
+    held_back_.clear();
+    return Offered::kAdded;
+  }
+  const bool continues = !held_back_.empty() && sample.stamp > held_back_.back().stamp &&
+                         sample.stamp - held_back_.back().stamp <= max_gap_;
+  if (!continues) held_back_.clear();
+  held_back_.push_back(sample);
+  if (static_cast<int>(held_back_.size()) < kSamplesToRestart) return Offered::kHeldBack;
+  restart();
+  return Offered::kRestarted;
+}
+
+void PoseBuffer::restart() {
+  samples_.swap(held_back_);
+  held_back_.clear();
+}
+
 LookupStatus PoseBuffer::poseAt(double stamp, Eigen::Isometry3d* pose) const {
   if (samples_.empty()) return LookupStatus::kEmpty;
   if (stamp > samples_.back().stamp) return LookupStatus::kNotYet;

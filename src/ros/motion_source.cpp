@@ -20,47 +20,53 @@ MotionSource::MotionSource(ros::NodeHandle& nh, const RosConfig& config, tf2_ros
 }
 
 void MotionSource::odomCallback(const nav_msgs::Odometry::ConstPtr& message) {
-  if (!isFinitePose(message->pose.pose)) {
+  const std::string problem = poseProblem(message->pose.pose);
+  if (!problem.empty()) {
     ++rejected_samples;
-    ROS_WARN_THROTTLE(5.0, "online_stereo_calibration: odometry with a non-finite pose ignored");
-    if (on_problem) on_problem("rejected odometry", "odometry with a non-finite pose ignored");
+    const std::string why = "odometry with " + problem + " ignored";
+    ROS_WARN_THROTTLE(5.0, "online_stereo_calibration: %s", why.c_str());
+    if (on_problem) on_problem("rejected odometry", why);
     return;
   }
   StampedPose sample{message->header.stamp.toSec(), isometryFromPose(message->pose.pose)};
-  bool added = false;
-  double jumped_back = 0.0;
+  PoseBuffer::Offered offered;
+  double newest = 0.0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    added = poses_.add(sample);
-    if (!added && !poses_.empty() && sample.stamp < poses_.newestStamp() - config_.max_motion_gap) {
-      // Time jumped back (a bag loop, a restarted player): start a new history.
-      jumped_back = poses_.newestStamp() - sample.stamp;
-      poses_.clear();
-      gyro_.clear();
-      added = poses_.add(sample);
-    }
+    newest = poses_.newestStamp();
+    offered = poses_.offer(sample);
+    if (offered == PoseBuffer::Offered::kRestarted) gyro_.clear();
   }
-  if (jumped_back > 0.0) {
-    ROS_WARN(
-        "online_stereo_calibration: odometry time went back by %.3f s: motion history "
-        "cleared",
-        jumped_back);
-    if (on_problem) {
-      on_problem("time went backwards",
-                 "odometry time went back by " + std::to_string(jumped_back) + " s");
+  switch (offered) {
+    case PoseBuffer::Offered::kAdded:
+      break;
+    case PoseBuffer::Offered::kRestarted: {
+      // Time jumped back (a bag loop, a restarted player): a new history.
+      const double back = newest - sample.stamp;
+      ROS_WARN(
+          "online_stereo_calibration: odometry time went back by %.3f s: motion history "
+          "restarted",
+          back);
+      if (on_problem) {
+        on_problem("time went backwards",
+                   "odometry time went back by " + std::to_string(back) + " s");
+      }
+      break;
     }
-  }
-  if (!added) {
-    ++rejected_samples;
-    ROS_WARN_THROTTLE(5.0,
-                      "online_stereo_calibration: odometry stamp %.9f not newer than the last "
-                      "one, ignored",
-                      sample.stamp);
-    if (on_problem) {
-      on_problem("rejected odometry", "odometry stamp " + std::to_string(sample.stamp) +
-                                          " not newer than the last one, ignored");
+    case PoseBuffer::Offered::kHeldBack:
+    case PoseBuffer::Offered::kRejected: {
+      ++rejected_samples;
+      const std::string why =
+          offered == PoseBuffer::Offered::kHeldBack
+              ? "odometry stamp " + std::to_string(sample.stamp) + " is " +
+                    std::to_string(newest - sample.stamp) +
+                    " s behind the newest (a stale publisher?), ignored unless more follow"
+              : "odometry stamp " + std::to_string(sample.stamp) +
+                    " not newer than the last one, ignored";
+      ROS_WARN_THROTTLE(5.0, "online_stereo_calibration: %s", why.c_str());
+      if (on_problem) on_problem("rejected odometry", why);
+      return;
     }
-    return;
   }
   if (on_odom) on_odom();
 }
@@ -122,9 +128,9 @@ LookupStatus MotionSource::motionBetween(const ros::Time& previous, const ros::T
   return LookupStatus::kOk;
 }
 
-void MotionSource::clear() {
+void MotionSource::restart() {
   std::lock_guard<std::mutex> lock(mutex_);
-  poses_.clear();
+  poses_.restart();
   gyro_.clear();
 }
 

@@ -507,6 +507,39 @@ TEST_F(BadImages, AreRejectedWithAStatusAndTheEstimatorUntouched) {
   EXPECT_TRUE(pipeline_.process(mono16, good_, MotionIncrement()).processed);
 }
 
+// Issue 17: a refused pair between two good ones must not change what the next one does.
+// The caller hands the motion since the last processed pair; were the refused pair's motion
+// kept and added to it (as before), the next step would see 0.15 s and 0.525 m instead of
+// 0.1 s and 0.35 m, and the estimate would differ.
+TEST_F(BadImages, ARefusedPairChangesNothingForTheNextPair) {
+  CalibrationPipeline clean(FilterConfig(), FrontEndConfig(), intrinsics_, intrinsics_,
+                            StereoExtrinsics::fromParameters(paperOffroadScenario().truth));
+  cv::Mat shifted;  // 12 px of disparity everywhere: stereo matches and new points
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, -12, 0, 1, 0);
+  cv::warpAffine(good_, shifted, shift, good_.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  MotionIncrement step;
+  step.dt = 0.1;
+  step.T_prev_curr.translation() = Eigen::Vector3d(0.35, 0.0, 0.0);
+  MotionIncrement half = step;
+  half.dt = 0.05;
+  half.T_prev_curr.translation() = Eigen::Vector3d(0.175, 0.0, 0.0);
+  for (CalibrationPipeline* p : {&clean, &pipeline_}) {
+    ASSERT_TRUE(p->process(good_, shifted, MotionIncrement()).processed);
+    ASSERT_TRUE(p->process(good_, shifted, step).processed);
+  }
+  // The refused pair (0x0, then a wrong size), half a step after the last processed one.
+  EXPECT_FALSE(pipeline_.process(cv::Mat(), shifted, half).processed);
+  EXPECT_FALSE(pipeline_.process(good_, cv::Mat(240, 320, CV_8UC1, cv::Scalar(9)), half).processed);
+  const PipelineResult a = clean.process(good_, shifted, step);
+  const PipelineResult b = pipeline_.process(good_, shifted, step);
+  ASSERT_TRUE(a.processed && b.processed);
+  EXPECT_GT(a.estimate.tracked_points, 0u);
+  EXPECT_EQ(a.estimate.parameters, b.estimate.parameters);
+  EXPECT_EQ(a.estimate.tangent_covariance, b.estimate.tangent_covariance);
+  EXPECT_EQ(a.front_end.tracked, b.front_end.tracked);
+  EXPECT_EQ(clean.estimator().filter().pointCount(), pipeline_.estimator().filter().pointCount());
+}
+
 // ---------------------------------------------------------------------------------------
 // Real images: EuRoC V1_01_easy, 752x480, plumb_bob.
 // ---------------------------------------------------------------------------------------

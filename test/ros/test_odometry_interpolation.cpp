@@ -3,6 +3,7 @@
 /// SLERP) against a known trajectory, the pose buffer and gyro integrator, CameraInfo ->
 /// CameraIntrinsics, and the calibration message's transforms vs. its parameters.
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -62,6 +63,80 @@ TEST(PoseBuffer, InterpolatesAtImageStampsAndReportsWhy) {
   // A gap larger than max_gap is reported, not bridged.
   EXPECT_TRUE(buffer.add({3.0, truthAt(3.0)}));
   EXPECT_EQ(buffer.poseAt(2.0, &pose), LookupStatus::kGap);
+}
+
+// Issue 17: one stale odometry message must not wipe the history; a time line that really
+// went back (a bag loop) is adopted after PoseBuffer::kSamplesToRestart samples.
+TEST(PoseBuffer, OneStaleSampleIsRefusedButANewTimeLineIsAdopted) {
+  using Offered = PoseBuffer::Offered;
+  PoseBuffer buffer(10.0, 0.5);
+  for (int i = 0; i <= 100; ++i) {
+    ASSERT_EQ(buffer.offer({10.0 + 0.01 * i, truthAt(10.0 + 0.01 * i)}), Offered::kAdded);
+  }
+  Eigen::Isometry3d pose;
+  // A single message 2 s back: held, not used; the history still answers.
+  EXPECT_EQ(buffer.offer({9.0, truthAt(9.0)}), Offered::kHeldBack);
+  EXPECT_EQ(buffer.poseAt(10.5, &pose), LookupStatus::kOk);
+  EXPECT_EQ(buffer.newestStamp(), 11.0);
+  // A normal sample forgets it: stale messages interleaved with live ones never restart.
+  for (int i = 1; i <= 2 * PoseBuffer::kSamplesToRestart; ++i) {
+    EXPECT_EQ(buffer.offer({11.0 + 0.01 * i, truthAt(11.0 + 0.01 * i)}), Offered::kAdded);
+    EXPECT_EQ(buffer.offer({9.0 + 0.01 * i, truthAt(9.0 + 0.01 * i)}), Offered::kHeldBack);
+  }
+  EXPECT_EQ(buffer.poseAt(10.5, &pose), LookupStatus::kOk);
+  // Duplicates within max_gap are still refused, not held.
+  EXPECT_EQ(buffer.offer({11.05, truthAt(11.05)}), Offered::kRejected);
+  // A bag loop: consecutive samples from t = 1 s on.
+  for (int i = 0; i + 1 < PoseBuffer::kSamplesToRestart; ++i) {
+    EXPECT_EQ(buffer.offer({1.0 + 0.01 * i, truthAt(1.0 + 0.01 * i)}), Offered::kHeldBack);
+  }
+  const double last = 1.0 + 0.01 * (PoseBuffer::kSamplesToRestart - 1);
+  EXPECT_EQ(buffer.offer({last, truthAt(last)}), Offered::kRestarted);
+  EXPECT_EQ(buffer.newestStamp(), last);
+  ASSERT_EQ(buffer.poseAt(1.015, &pose), LookupStatus::kOk);
+  expectPoseNear(pose, truthAt(1.015), 1e-12);
+  EXPECT_EQ(buffer.poseAt(10.5, &pose), LookupStatus::kNotYet);
+  // The images went back first: restart() adopts what was held back so far.
+  EXPECT_EQ(buffer.offer({0.2, truthAt(0.2)}), Offered::kHeldBack);
+  EXPECT_EQ(buffer.offer({0.21, truthAt(0.21)}), Offered::kHeldBack);
+  buffer.restart();
+  EXPECT_EQ(buffer.newestStamp(), 0.21);
+  EXPECT_EQ(buffer.poseAt(0.205, &pose), LookupStatus::kOk);
+  buffer.restart();  // nothing held: empty
+  EXPECT_TRUE(buffer.empty());
+}
+
+TEST(PoseProblem, NamesNonFiniteFieldsAndZeroQuaternions) {
+  geometry_msgs::Pose pose;
+  pose.orientation.w = 1.0;
+  EXPECT_EQ(poseProblem(pose), "");
+  pose.orientation.w = 1.3;  // unnormalised but a rotation
+  EXPECT_EQ(poseProblem(pose), "");
+  pose.position.y = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(poseProblem(pose), "a non-finite pose");
+  pose.position.y = 0.0;
+  pose.orientation.x = std::nan("");
+  EXPECT_EQ(poseProblem(pose), "a non-finite pose");
+  pose.orientation.x = 0.0;
+  pose.orientation.w = 0.0;
+  EXPECT_NE(poseProblem(pose).find("quaternion of norm 0.0"), std::string::npos);
+}
+
+TEST(ImageBuffer, ShortStepOrDataIsNamed) {
+  sensor_msgs::Image image;
+  image.width = 4;
+  image.height = 3;
+  image.step = 8;  // mono16
+  image.data.resize(24);
+  EXPECT_EQ(imageBufferProblem(image, 2), "");
+  image.data.resize(23);
+  EXPECT_NE(imageBufferProblem(image, 2).find("data of 23 bytes shorter than step x height"),
+            std::string::npos);
+  image.step = 6;
+  EXPECT_NE(imageBufferProblem(image, 2).find("step 6 shorter than a row"), std::string::npos);
+  image.width = 0xFFFFFFFFu;  // no overflow into a small product
+  image.step = 0xFFFFFFFFu;
+  EXPECT_NE(imageBufferProblem(image, 3).find("shorter"), std::string::npos);
 }
 
 TEST(GyroIntegrator, IntegratesConstantRate) {

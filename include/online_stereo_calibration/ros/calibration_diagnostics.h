@@ -35,7 +35,11 @@ class CalibrationDiagnostics {
   void recordProblem(const std::string& kind, const std::string& message);
   /// The estimate after a processed pair and its StereoCalibration state.
   void recordEstimate(const osc::CalibrationEstimate& estimate, uint8_t state);
-  /// Publishes now if the period elapsed (call from a timer).
+  /// ~reset was called: the estimate is forgotten until the next processed pair, and the
+  /// number of resets is reported.
+  void recordReset();
+  /// Publishes now if the period elapsed (call from a timer); at once if the clock went
+  /// back since the last call (a looped bag), whatever the period.
   void update();
   /// Latest value of a counter (tests, logging).
   int count(const std::string& kind) const;
@@ -75,6 +79,9 @@ class CalibrationDiagnostics {
   /// long ago it was, not by whole report periods without one (reports are not punctual).
   ros::WallTime last_odom_wall_;
   std::string initial_guess_;
+  /// ROS time of the last update() call, to see the clock go back.
+  ros::Time last_update_;
+  int resets_ = 0;
   bool have_estimate_ = false;
   osc::CalibrationEstimate estimate_;
   uint8_t state_ = 0;

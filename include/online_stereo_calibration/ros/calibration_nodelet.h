@@ -57,8 +57,10 @@ class CalibrationNodelet : public nodelet::Nodelet {
                     const sensor_msgs::CameraInfoConstPtr& right_info);
   void workerLoop();
   void processPair(const StereoPair& pair);
-  /// Creates or re-creates the pipeline for new intrinsics; false if they are unusable.
-  bool preparePipeline(const StereoPair& pair);
+  /// Creates or re-creates the pipeline for new intrinsics; false (pair refused, reported) if
+  /// they are unusable or do not describe the images.
+  bool preparePipeline(const StereoPair& pair, const cv::Mat& left_image,
+                       const cv::Mat& right_image);
   /// Waits up to motion_wait for the motion; false (pair skipped) if it does not come.
   bool waitForMotion(const ros::Time& stamp, osc::MotionIncrement* motion);
   bool resetService(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);

@@ -8,6 +8,7 @@
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Transform.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
 #include <Eigen/Geometry>
 
 #include "online_stereo_calibration/core/geometry/camera_model.h"
@@ -19,6 +20,11 @@ namespace online_stereo_calibration {
 /// @throws std::invalid_argument naming the problem (uncalibrated K, unknown model, wrong
 /// number of coefficients, non-positive size).
 osc::CameraIntrinsics intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info);
+
+/// Why an image message's buffer cannot hold its pixels (step shorter than a row, data
+/// shorter than step x height), or "" if it can. @p bytes_per_pixel: of its encoding.
+/// Checked before the pixels are touched: a short buffer would be read past its end.
+std::string imageBufferProblem(const sensor_msgs::Image& image, int bytes_per_pixel);
 
 /// True if two intrinsics differ in any field (camera_info changed).
 bool intrinsicsDiffer(const osc::CameraIntrinsics& a, const osc::CameraIntrinsics& b);
@@ -37,8 +43,9 @@ geometry_msgs::Transform transformFromIsometry(const Eigen::Isometry3d& pose);
 osc::Matrix12d tangentCovarianceFromParameterCovariance(const osc::StereoExtrinsics& extrinsics,
                                                         const osc::Matrix12d& parameter_covariance);
 
-/// True if every field of the pose is finite and the quaternion has a usable norm.
-bool isFinitePose(const geometry_msgs::Pose& pose);
+/// Why a pose cannot be used (a NaN or Inf field, a quaternion far from unit norm, e.g. all
+/// zero), or "" if it can.
+std::string poseProblem(const geometry_msgs::Pose& pose);
 
 /// A pose with its time (s).
 struct StampedPose {

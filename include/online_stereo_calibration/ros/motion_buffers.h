@@ -37,11 +37,30 @@ class PoseBuffer {
   /// is not newer than the newest sample (duplicate or out of order).
   bool add(const StampedPose& sample);
 
+  /// What offer() did with a sample.
+  enum class Offered {
+    kAdded,      ///< added to the history
+    kRejected,   ///< not finite, or not newer than the newest but within max_gap of it
+    kHeldBack,   ///< more than max_gap behind the newest: held, not used (see offer())
+    kRestarted,  ///< time went back: the history is now the held-back samples
+  };
+  /// Consecutive held-back samples that make a new time line (offer()).
+  static constexpr int kSamplesToRestart = 5;
+
+  /// add() for a live topic whose time may jump back (a looped bag, a restarted player)
+  /// while a single stale message (a second publisher, a late retransmission) must not wipe
+  /// the history. A sample more than max_gap behind the newest is held back; it becomes
+  /// history only with kSamplesToRestart - 1 more held-back samples, each newer than the one
+  /// before and within max_gap of it. A sample added normally forgets the held ones.
+  Offered offer(const StampedPose& sample);
+
+  /// Starts a new time line (the images jumped back): the history becomes the samples held
+  /// back so far (often the first odometry of the new time line), or empty.
+  void restart();
+
   /// The pose at @p stamp, interpolated between the two samples bracketing it.
   LookupStatus poseAt(double stamp, Eigen::Isometry3d* pose) const;
 
-  /// Drops every sample (time went backwards).
-  void clear() { samples_.clear(); }
   bool empty() const { return samples_.empty(); }
   double newestStamp() const { return samples_.empty() ? 0.0 : samples_.back().stamp; }
 
@@ -49,6 +68,7 @@ class PoseBuffer {
   double history_;
   double max_gap_;
   std::deque<StampedPose> samples_;
+  std::deque<StampedPose> held_back_;  ///< offer(): a possible new time line
 };
 
 /// Angular rates (rad/s, vehicle frame) integrated into a rotation between two stamps,

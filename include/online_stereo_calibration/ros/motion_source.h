@@ -31,15 +31,16 @@ class MotionSource {
                              osc::MotionIncrement* motion);
   /// Whether the vehicle pose at @p stamp is known.
   LookupStatus poseAvailable(const ros::Time& stamp);
-  /// Forgets every sample (time went backwards).
-  void clear();
+  /// A new time line (the images went back in time): forgets the history but keeps the
+  /// odometry already held back as the start of the new one (PoseBuffer::restart()).
+  void restart();
 
   /// Called for each accepted odometry / imu sample (frequency diagnostics).
   std::function<void()> on_odom;
   std::function<void()> on_imu;
-  /// Called with a reason for each ignored sample (non-finite, out of order) and with a
-  /// description when odometry time jumped back by more than max_motion_gap (a bag loop:
-  /// the history is then cleared and the sample kept).
+  /// Called with a reason for each ignored sample (non-finite, out of order, a single
+  /// sample far in the past) and with a description when odometry time jumped back for good
+  /// (PoseBuffer::offer(): a bag loop; the history then restarts from the new samples).
   std::function<void(const std::string& kind, const std::string& message)> on_problem;
   /// Samples ignored (non-finite, duplicated or out-of-order stamps).
   std::atomic<int> rejected_samples{0};

@@ -30,16 +30,9 @@ CalibrationPipeline::CalibrationPipeline(const FilterConfig& filter_config,
 CalibrationPipeline::~CalibrationPipeline() = default;
 
 PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& right,
-                                            const MotionIncrement& motion_since_previous) {
+                                            const MotionIncrement& motion_since_last_processed) {
   const auto start = std::chrono::steady_clock::now();
   PipelineResult result;
-  // A skipped pair's motion is kept and composed with the next one, so that the motion
-  // handed to the estimator always spans the time since the last processed pair.
-  MotionIncrement motion = motion_since_previous;
-  if (has_pending_motion_) {
-    motion.T_prev_curr = pending_motion_.T_prev_curr * motion_since_previous.T_prev_curr;
-    motion.dt = pending_motion_.dt + motion_since_previous.dt;
-  }
   const FrontEndConfig& config = front_end_->config();
   cv::Mat left_mono, right_mono;
   std::string problem =
@@ -52,23 +45,19 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
     problem = "left and right images differ in size";
   }
   if (!problem.empty()) {
+    // Refused: nothing changes, so the caller's next motion (since the last processed pair)
+    // is exactly what the estimator needs.
     result.processed = false;
     result.status = problem;
-    if (processed_any_) {
-      pending_motion_ = motion;
-      has_pending_motion_ = true;
-    }
     result.estimate = estimator_->estimate();
     result.processing_time =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
   }
-  const std::vector<StereoObservation> observations =
-      front_end_->observe(left_mono, right_mono, motion, estimator_->filter(), &result.front_end);
-  result.estimator = estimator_->processFrame(motion, observations);
+  const std::vector<StereoObservation> observations = front_end_->observe(
+      left_mono, right_mono, motion_since_last_processed, estimator_->filter(), &result.front_end);
+  result.estimator = estimator_->processFrame(motion_since_last_processed, observations);
   front_end_->commit(result.estimator, estimator_->filter());
-  has_pending_motion_ = false;
-  processed_any_ = true;
   result.processed = true;
   result.status =
       result.estimator.motion_rejected ? "processed (motion rejected, tracks reset)" : "ok";
@@ -127,7 +116,6 @@ bool CalibrationPipeline::rightCameraMoved(double* rotation_sigma) {
 
 void CalibrationPipeline::restartFrontEnd() {
   front_end_->reset();
-  has_pending_motion_ = false;
   pairs_without_stereo_ = pairs_off_their_lines_ = 0;
 }
 

@@ -57,9 +57,15 @@ class CalibrationPipeline {
 
   /// Processes one synchronized stereo pair. Images: CV_8UC1, CV_16UC1, CV_8UC3 (BGR) or
   /// CV_8UC4 (BGRA), raw (distorted, as the camera models say) or rectified; the sizes must
-  /// match the camera intrinsics. motion_since_previous is ignored for the first pair.
+  /// match the camera intrinsics.
+  ///
+  /// @p motion_since_last_processed is the vehicle motion between the stamp of the last pair
+  /// this returned processed = true for and this pair's stamp (ignored for the first pair).
+  /// A refused pair (processed = false) changes no state at all: the caller keeps its last
+  /// processed stamp, so every motion handed to the estimator spans exactly the time between
+  /// two processed pairs (a refused pair's motion is never counted twice).
   PipelineResult process(const cv::Mat& left, const cv::Mat& right,
-                         const MotionIncrement& motion_since_previous);
+                         const MotionIncrement& motion_since_last_processed);
 
   /// Forgets all tracks (e.g. time jumped back); the calibration is kept.
   void resetTracking();
@@ -92,10 +98,6 @@ class CalibrationPipeline {
 
   std::unique_ptr<StereoCalibrationEstimator> estimator_;
   std::unique_ptr<StereoFrontEnd> front_end_;
-  /// Motion of skipped (unusable) pairs since the last processed one, composed.
-  MotionIncrement pending_motion_;
-  bool has_pending_motion_ = false;
-  bool processed_any_ = false;
   /// Consecutive processed pairs without a stereo pair although both images had features.
   int pairs_without_stereo_ = 0;
   /// Consecutive processed pairs whose refined pairs lay off their lines (rightCameraMoved).
