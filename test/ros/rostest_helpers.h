@@ -43,15 +43,18 @@ inline bool spinUntil(const std::function<bool()>& done, double timeout) {
   return done();
 }
 
-/// Every "...: calibration" status published on /diagnostics.
+/// Every "...: calibration" status published on /diagnostics (only those whose name starts
+/// with @p node_prefix, e.g. "dirty/", if given: one of several nodes).
 class DiagnosticsCollector {
  public:
-  explicit DiagnosticsCollector(ros::NodeHandle& nh) {
+  explicit DiagnosticsCollector(ros::NodeHandle& nh, const std::string& node_prefix = "") {
     sub_ = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
-        "/diagnostics", 100, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+        "/diagnostics", 100,
+        [this, node_prefix](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
           std::lock_guard<std::mutex> lock(mutex_);
           for (const auto& status : array->status) {
             const std::string suffix = ": calibration";
+            if (status.name.compare(0, node_prefix.size(), node_prefix) != 0) continue;
             if (status.name.size() >= suffix.size() &&
                 status.name.compare(status.name.size() - suffix.size(), suffix.size(), suffix) ==
                     0) {
@@ -296,27 +299,40 @@ class RenderedDrive {
   /// Publishes the odometry up to two samples past the frame's stamp, then the pair.
   /// Returns the wall seconds spent rendering.
   double publish(int frame) {
-    const double until = simulator_->frameStamp(frame) + 0.025;
+    publishOdometryUntil(simulator_->frameStamp(frame) + 0.025);
+    const ros::WallTime start = ros::WallTime::now();
+    const osc::SimulatedImagePair pair = simulator_->renderFrame(frame);
+    const double render = (ros::WallTime::now() - start).toSec();
+    publishPair(pair, stamp(frame));
+    return render;
+  }
+
+  /// Publishes the odometry samples not yet published with stamps up to @p until (s).
+  void publishOdometryUntil(double until) {
     while (next_odom_ < odometry_.size() && odometry_[next_odom_].stamp <= until) {
       odom_.publish(osc::bag::toOdometry(odometry_[next_odom_], names_));
       ++next_odom_;
     }
-    const ros::WallTime start = ros::WallTime::now();
-    const osc::SimulatedImagePair pair = simulator_->renderFrame(frame);
-    const double render = (ros::WallTime::now() - start).toSec();
-    const ros::Time t = stamp(frame);
+  }
+
+  /// Publishes @p pair's images and the drive's camera_info, all stamped @p t.
+  void publishPair(const osc::SimulatedImagePair& pair, const ros::Time& t) {
     std_msgs::Header header;
     header.stamp = t;
-    header.seq = frame;
+    header.seq = pair.frame;
     header.frame_id = names_.left_frame;
     left_.publish(cv_bridge::CvImage(header, "mono8", pair.left).toImageMsg());
-    left_info_.publish(
-        osc::bag::toCameraInfo(simulator_->scenario().measurement.left, t, names_.left_frame));
+    left_info_.publish(leftInfo(t));
     header.frame_id = names_.right_frame;
     right_.publish(cv_bridge::CvImage(header, "mono8", pair.right).toImageMsg());
-    right_info_.publish(
-        osc::bag::toCameraInfo(simulator_->scenario().measurement.right, t, names_.right_frame));
-    return render;
+    right_info_.publish(rightInfo(t));
+  }
+
+  sensor_msgs::CameraInfo leftInfo(const ros::Time& t) const {
+    return osc::bag::toCameraInfo(simulator_->scenario().measurement.left, t, names_.left_frame);
+  }
+  sensor_msgs::CameraInfo rightInfo(const ros::Time& t) const {
+    return osc::bag::toCameraInfo(simulator_->scenario().measurement.right, t, names_.right_frame);
   }
 
   const osc::bag::DriveTopics& names() const { return names_; }
