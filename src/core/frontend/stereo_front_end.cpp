@@ -117,8 +117,10 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   last_bands_.clear();
   pending_.clear();
 
-  const FeatureSet left = detector_.detect(left_mono, left_camera_);
-  const FeatureSet right = detector_.detect(right_mono, right_camera_);
+  left_features_ = detector_.detect(left_mono, left_camera_);
+  right_features_ = detector_.detect(right_mono, right_camera_);
+  const FeatureSet& left = left_features_;
+  const FeatureSet& right = right_features_;
   stats.features_left = static_cast<int>(left.size());
   stats.features_right = static_cast<int>(right.size());
   std::vector<char> left_used(left.size(), 0), right_used(right.size(), 0);

@@ -6,6 +6,7 @@
 
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/frontend/feature_detection.h"
+#include "online_stereo_calibration/core/frontend/global_stereo_fit.h"
 #include "online_stereo_calibration/core/frontend/stereo_front_end.h"
 
 namespace osc {
@@ -68,8 +69,12 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   double rotation_sigma = 0.0;
   std::string why;
   if (lostTheStereoGeometry(result.front_end)) {
-    rotation_sigma = estimator_->filter().config().initial_camr_rotation_sigma;
-    why = "no stereo pair in 2 pairs with features in both images";
+    // No pair may mean a knocked camera or merely a view without usable texture (sky, a
+    // wall, darkness, blur): only a whole-image fit that contradicts x_camr re-opens it.
+    if (wholeImageFitContradicts(&rotation_sigma, &result.status)) {
+      why = "no stereo pair in 2 pairs, and the whole-image fits of 2 pairs contradict x_camr (" +
+            result.status + ")";
+    }
   } else if (rightCameraMoved(&rotation_sigma)) {
     why = "the stereo pairs of 2 pairs off their epipolar lines by " +
           std::to_string(front_end_->lastEpipolarTrend().rms()) + " px";
@@ -114,9 +119,39 @@ bool CalibrationPipeline::rightCameraMoved(double* rotation_sigma) {
   return pairs_off_their_lines_ >= kKnockedPairsBeforeReopening;
 }
 
+bool CalibrationPipeline::wholeImageFitContradicts(double* rotation_sigma, std::string* status) {
+  constexpr double kKnockSigmas = 5.0;
+  constexpr double kMinAngle = 0.05 * M_PI / 180.0;  // rad: below, not worth a re-opening
+  const Eigen::Isometry3d T_lopt_ropt = estimator_->filter().extrinsics().leftToRightOptical();
+  last_fit_ = fitStereoGeometry(front_end_->lastLeftFeatures(), front_end_->lastRightFeatures(),
+                                estimator_->leftCamera(), estimator_->rightCamera(),
+                                T_lopt_ropt.translation().normalized());
+  const double estimate_sigma = std::sqrt(estimator_->filter()
+                                              .covariance()
+                                              .diagonal()
+                                              .segment<3>(layout::kCamr + layout::kRotation)
+                                              .maxCoeff());
+  double angle = 0.0;
+  bool contradicts = false;
+  if (last_fit_.valid) {
+    angle = rotationAngleBetween(last_fit_.R_lopt_ropt, T_lopt_ropt.linear());
+    const double fit_sigma = std::sqrt(last_fit_.rotation_covariance.diagonal().maxCoeff());
+    contradicts = angle > kMinAngle && angle > kKnockSigmas * std::hypot(estimate_sigma, fit_sigma);
+  }
+  fits_contradicting_ = contradicts ? fits_contradicting_ + 1 : 0;
+  *rotation_sigma = 3.0 * angle;
+  *status = last_fit_.valid ? "whole-image fit " + std::to_string(angle * 180.0 / M_PI) +
+                                  " deg from x_camr, " + last_fit_.why
+                            : "no whole-image fit: " + last_fit_.why;
+  if (!contradicts) {
+    *status = "too few stereo pairs (" + *status + "): x_camr kept";
+  }
+  return fits_contradicting_ >= kKnockedPairsBeforeReopening;
+}
+
 void CalibrationPipeline::restartFrontEnd() {
   front_end_->reset();
-  pairs_without_stereo_ = pairs_off_their_lines_ = 0;
+  pairs_without_stereo_ = pairs_off_their_lines_ = fits_contradicting_ = 0;
 }
 
 void CalibrationPipeline::resetTracking() {

@@ -62,6 +62,9 @@ class StereoFrontEnd {
   const EpipolarTrend& lastEpipolarTrend() const { return epipolar_trend_; }
   /// Points being tracked.
   size_t trackCount() const { return tracker_.size(); }
+  /// The keypoints detected in the last pair's left and right images.
+  const FeatureSet& lastLeftFeatures() const { return left_features_; }
+  const FeatureSet& lastRightFeatures() const { return right_features_; }
 
   /// The last pair side by side (BGR): tracks green, new candidates blue with their
   /// epipolar bands (centre line and band edges, eq. 5-6) magenta in the right image, other
@@ -102,7 +105,8 @@ class StereoFrontEnd {
   };
   std::vector<Pending> pending_;
   cv::Mat last_left_, last_right_;
-  cv::Mat previous_left_, current_left_;  ///< copies: the left images of the last two pairs
+  FeatureSet left_features_, right_features_;  ///< of the last pair
+  cv::Mat previous_left_, current_left_;       ///< copies: the left images of the last two pairs
   /// The last pair's common epipolar distance of refined pairs, for a frame with too few
   /// tracked pairs to fit its own.
   EpipolarTrend epipolar_trend_;

@@ -13,6 +13,7 @@
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
 #include "online_stereo_calibration/core/frontend/front_end_config.h"
+#include "online_stereo_calibration/core/frontend/global_stereo_fit.h"
 
 namespace osc {
 
@@ -38,8 +39,9 @@ struct PipelineResult {
   FrontEndStatistics front_end;
   CalibrationEstimate estimate;  ///< the estimate after this pair
   /// A knocked right camera: no stereo pair found in this and the previous pair although
-  /// both images had features, or the refined pairs of both off their epipolar lines by far
-  /// more than x_camr's sigma allows. x_camr's rotation was re-opened and tracking restarted.
+  /// both images had features and the whole-image fits of both contradict x_camr, or the
+  /// refined pairs of both off their epipolar lines by far more than x_camr's sigma allows.
+  /// x_camr's rotation was re-opened and tracking restarted.
   bool right_camera_reopened = false;
   double processing_time = 0.0;  ///< seconds spent on this pair (front end + filter)
 };
@@ -91,6 +93,11 @@ class CalibrationPipeline {
   /// Counts pairs in which no stereo pair was found although both images had features; true
   /// (a knocked right camera) from the second in a row.
   bool lostTheStereoGeometry(const FrontEndStatistics& stats);
+  /// After lostTheStereoGeometry: fits the pair's epipolar geometry over the whole images
+  /// (fitStereoGeometry) and counts fits whose rotation is more than kKnockSigmas combined
+  /// sigmas (and 0.05 deg) from x_camr's; true from the second in a row, with 3 times that
+  /// angle as the rotation sigma to re-open with. @p status says what was seen.
+  bool wholeImageFitContradicts(double* rotation_sigma, std::string* status);
   /// Counts pairs whose refined pairs lie off their epipolar lines (EpipolarTrend) by an angle
   /// of more than kKnockSigmas x_camr rotation sigmas; true from the second in a row, with
   /// the rotation sigma that distance calls for.
@@ -102,6 +109,9 @@ class CalibrationPipeline {
   int pairs_without_stereo_ = 0;
   /// Consecutive processed pairs whose refined pairs lay off their lines (rightCameraMoved).
   int pairs_off_their_lines_ = 0;
+  /// Consecutive whole-image fits contradicting x_camr (wholeImageFitContradicts).
+  int fits_contradicting_ = 0;
+  GlobalStereoFit last_fit_;
 };
 
 }  // namespace osc

@@ -1,0 +1,184 @@
+/// @file global_stereo_fit.cpp
+/// @brief fitStereoGeometry: whole-image matching + five-point RANSAC.
+#include "online_stereo_calibration/core/frontend/global_stereo_fit.h"
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "online_stereo_calibration/core/frontend/feature_detection.h"
+#include "online_stereo_calibration/core/geometry/camera_model.h"
+#include "online_stereo_calibration/core/geometry/rotation.h"
+
+namespace osc {
+namespace {
+
+/// Best and second-best distance of keypoint i of @p from among all of @p to.
+struct Nearest {
+  int best = -1;
+  double best_distance = std::numeric_limits<double>::infinity();
+  double second_distance = std::numeric_limits<double>::infinity();
+};
+
+std::vector<Nearest> nearestNeighbours(const FeatureSet& from, const FeatureSet& to) {
+  std::vector<Nearest> nearest(from.size());
+  for (size_t i = 0; i < from.size(); ++i) {
+    Nearest& n = nearest[i];
+    for (size_t j = 0; j < to.size(); ++j) {
+      const double d = from.distance(static_cast<int>(i), to, static_cast<int>(j));
+      if (d < n.best_distance) {
+        n.second_distance = n.best_distance;
+        n.best_distance = d;
+        n.best = static_cast<int>(j);
+      } else if (d < n.second_distance) {
+        n.second_distance = d;
+      }
+    }
+  }
+  return nearest;
+}
+
+/// Undistorted pixel (K * normalised) -> normalised image coordinates.
+cv::Point2d normalised(const Eigen::Matrix3d& K_inv, const Eigen::Vector2d& undistorted_pixel) {
+  const Eigen::Vector3d ray = K_inv * undistorted_pixel.homogeneous();
+  return {ray.x() / ray.z(), ray.y() / ray.z()};
+}
+
+/// Sampson distance (normalised units) of a ray pair under E = R_ropt_lopt [c]x, the
+/// essential matrix of a right camera at c (unit) in the left optical frame.
+double sampson(const Eigen::Matrix3d& E, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d Ea = E * a, Etb = E.transpose() * b;
+  const double denominator = Ea.head<2>().squaredNorm() + Etb.head<2>().squaredNorm();
+  return denominator > 0.0 ? b.dot(Ea) / std::sqrt(denominator) : 0.0;
+}
+
+struct RotationRefinement {
+  Eigen::Matrix3d R_lopt_ropt;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  double rms = 0.0;
+  bool rotation_covariance_ok = false;
+};
+
+/// Gauss-Newton on the Sampson distances over R_lopt_ropt = R * Exp(e), c held fixed.
+RotationRefinement refineRotation(const Eigen::Matrix3d& R_start, const Eigen::Vector3d& c,
+                                  const std::vector<Eigen::Vector3d>& left,
+                                  const std::vector<Eigen::Vector3d>& right) {
+  RotationRefinement out;
+  out.R_lopt_ropt = R_start;
+  const int n = static_cast<int>(left.size());
+  if (n < 4) return out;
+  Eigen::Matrix3d c_cross;
+  c_cross << 0, -c.z(), c.y(), c.z(), 0, -c.x(), -c.y(), c.x(), 0;
+  const auto residuals = [&](const Eigen::Matrix3d& R_lopt_ropt) {
+    const Eigen::Matrix3d E = R_lopt_ropt.transpose() * c_cross;
+    Eigen::VectorXd r(n);
+    for (int i = 0; i < n; ++i)
+      r(i) = sampson(E, left[static_cast<size_t>(i)], right[static_cast<size_t>(i)]);
+    return r;
+  };
+  constexpr double kStep = 1e-7;  // rad, numeric derivative
+  Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
+  Eigen::VectorXd r = residuals(out.R_lopt_ropt);
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    Eigen::MatrixXd J(n, 3);
+    for (int axis = 0; axis < 3; ++axis) {
+      const Eigen::Matrix3d R = out.R_lopt_ropt * expSO3(kStep * Eigen::Vector3d::Unit(axis));
+      J.col(axis) = (residuals(R) - r) / kStep;
+    }
+    JtJ = J.transpose() * J;
+    const Eigen::Vector3d step = JtJ.ldlt().solve(-J.transpose() * r);
+    if (!step.allFinite()) return out;
+    out.R_lopt_ropt = out.R_lopt_ropt * expSO3(step);
+    r = residuals(out.R_lopt_ropt);
+    if (step.norm() < 1e-10) break;
+  }
+  out.rms = std::sqrt(r.squaredNorm() / n);
+  // Sampson distances in normalised units are angles: s^2 (J^T J)^-1, s from the fit itself.
+  const double s2 = r.squaredNorm() / std::max(1, n - 3);
+  const Eigen::Matrix3d covariance = s2 * JtJ.inverse();
+  out.rotation_covariance_ok = covariance.allFinite() && covariance.diagonal().minCoeff() > 0.0;
+  if (out.rotation_covariance_ok) out.covariance = 0.5 * (covariance + covariance.transpose());
+  return out;
+}
+
+}  // namespace
+
+double rotationAngleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return logSO3(a.transpose() * b).norm();
+}
+
+GlobalStereoFit fitStereoGeometry(const FeatureSet& left, const FeatureSet& right,
+                                  const CameraModel& left_camera, const CameraModel& right_camera,
+                                  const Eigen::Vector3d& baseline_direction,
+                                  const GlobalStereoFitConfig& config) {
+  GlobalStereoFit fit;
+  if (left.size() < 5 || right.size() < 5 || left.descriptors.type() != right.descriptors.type()) {
+    fit.why = "fewer than 5 keypoints in an image";
+    return fit;
+  }
+  // Mutual best matches that pass the distance bound and the ratio test in both directions.
+  const std::vector<Nearest> left_to_right = nearestNeighbours(left, right);
+  const std::vector<Nearest> right_to_left = nearestNeighbours(right, left);
+  const Eigen::Matrix3d Kl_inv = left_camera.K().inverse(), Kr_inv = right_camera.K().inverse();
+  std::vector<cv::Point2d> points_left, points_right;
+  for (size_t i = 0; i < left.size(); ++i) {
+    const Nearest& forward = left_to_right[i];
+    if (forward.best < 0 || forward.best_distance > config.max_descriptor_distance) continue;
+    if (!(forward.best_distance < config.ratio * forward.second_distance)) continue;
+    const Nearest& backward = right_to_left[static_cast<size_t>(forward.best)];
+    if (backward.best != static_cast<int>(i)) continue;
+    if (!(backward.best_distance < config.ratio * backward.second_distance)) continue;
+    points_left.push_back(normalised(Kl_inv, left.undistorted[i]));
+    points_right.push_back(
+        normalised(Kr_inv, right.undistorted[static_cast<size_t>(forward.best)]));
+  }
+  fit.matches = static_cast<int>(points_left.size());
+  if (fit.matches < std::max(5, config.min_inliers)) {
+    fit.why = std::to_string(fit.matches) + " descriptor matches over the whole images";
+    return fit;
+  }
+  // The threshold in normalised units of the mean focal length of the two cameras.
+  const double focal = 0.25 * (left_camera.K()(0, 0) + left_camera.K()(1, 1) +
+                               right_camera.K()(0, 0) + right_camera.K()(1, 1));
+  cv::Mat mask;
+  const cv::Mat E = cv::findEssentialMat(points_left, points_right, 1.0, cv::Point2d(0, 0),
+                                         cv::RANSAC, 0.999, config.ransac_threshold / focal, mask);
+  if (E.rows != 3 || E.cols != 3) {
+    fit.why = "no essential matrix from " + std::to_string(fit.matches) + " matches";
+    return fit;
+  }
+  cv::Mat R, t;
+  fit.inliers = cv::recoverPose(E, points_left, points_right, R, t, 1.0, cv::Point2d(0, 0), mask);
+  if (fit.inliers < config.min_inliers) {
+    fit.why = std::to_string(fit.inliers) + " inliers of " + std::to_string(fit.matches) +
+              " matches (least " + std::to_string(config.min_inliers) + ")";
+    return fit;
+  }
+  // recoverPose: x_right = R x_left + t, i.e. T_ropt_lopt = [R | t].
+  Eigen::Matrix3d R_ropt_lopt;
+  Eigen::Vector3d t_ropt_lopt;
+  cv::cv2eigen(R, R_ropt_lopt);
+  cv::cv2eigen(t, t_ropt_lopt);
+  fit.free_baseline_direction = (-(R_ropt_lopt.transpose() * t_ropt_lopt)).normalized();
+  std::vector<Eigen::Vector3d> rays_left, rays_right;
+  for (size_t k = 0; k < points_left.size(); ++k) {
+    if (!mask.at<unsigned char>(static_cast<int>(k))) continue;
+    rays_left.emplace_back(points_left[k].x, points_left[k].y, 1.0);
+    rays_right.emplace_back(points_right[k].x, points_right[k].y, 1.0);
+  }
+  const RotationRefinement refined = refineRotation(
+      R_ropt_lopt.transpose(), baseline_direction.normalized(), rays_left, rays_right);
+  fit.R_lopt_ropt = refined.R_lopt_ropt;
+  fit.rotation_covariance = refined.covariance;
+  fit.rms_px = refined.rms * focal;
+  fit.valid = refined.rotation_covariance_ok;
+  fit.why = std::to_string(fit.inliers) + " inliers of " + std::to_string(fit.matches) +
+            " matches, " + std::to_string(fit.rms_px) + " px RMS" +
+            (fit.valid ? "" : ", rotation not determined");
+  return fit;
+}
+
+}  // namespace osc
