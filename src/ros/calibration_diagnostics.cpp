@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "online_stereo_calibration/StereoCalibration.h"
+#include "online_stereo_calibration/ros/output_publisher.h"
 
 namespace online_stereo_calibration {
 namespace {
@@ -187,6 +188,16 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
       level = std::max<unsigned char>(level, DiagnosticStatus::WARN);
       reasons.push_back("not converged");
     }
+    // What the motion does not determine is said, not hidden (it does not block CONVERGED).
+    static const char* const kNeeds[3] = {"no pitch/yaw excitation", "no roll/yaw excitation",
+                                          "no roll/pitch excitation"};
+    std::string undetermined;
+    for (int i : osc::undeterminedParameters(estimate_, config_.converged)) {
+      undetermined +=
+          (undetermined.empty() ? "" : ", ") + std::string(kParameterNames[i]) + ": " + kNeeds[i];
+    }
+    status.add("not determined by the motion", undetermined.empty() ? "-" : undetermined);
+    if (!undetermined.empty()) reasons.push_back(undetermined);
     if (static_cast<int>(estimate_.tracked_points) < config_.min_tracked_points) {
       level = std::max<unsigned char>(level, DiagnosticStatus::WARN);
       reasons.push_back("too few points");

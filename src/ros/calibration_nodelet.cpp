@@ -430,8 +430,7 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
   const bool jump =
       result.estimator.step.jump != osc::JumpBlock::kNone || result.right_camera_reopened;
   const uint8_t state = calibrationState(result.estimate, jump, config_.ros.min_tracked_points,
-                                         config_.ros.converged_translation_3sigma,
-                                         config_.ros.converged_rotation_3sigma);
+                                         config_.ros.converged);
   const StereoCalibration message =
       makeCalibrationMessage(result.estimate, stamp, frames_, state, result.processing_time);
   diagnostics_->recordEstimate(result.estimate, state);

@@ -16,19 +16,13 @@
 namespace online_stereo_calibration {
 
 uint8_t calibrationState(const osc::CalibrationEstimate& estimate, bool jump_detected,
-                         int min_tracked_points, double translation_3sigma,
-                         double rotation_3sigma) {
+                         int min_tracked_points, const osc::ConvergenceThresholds& thresholds) {
   if (jump_detected) return StereoCalibration::STATE_DIVERGED;
   if (static_cast<int>(estimate.tracked_points) < min_tracked_points) {
     return StereoCalibration::STATE_INITIALIZING;
   }
-  const osc::Vector12d sigma = estimate.sigmas();
-  for (int i = 0; i < 12; ++i) {
-    const bool translation = (i % 6) < 3;
-    const double bound = translation ? translation_3sigma : rotation_3sigma;
-    if (!(3.0 * sigma(i) <= bound)) return StereoCalibration::STATE_CONVERGING;
-  }
-  return StereoCalibration::STATE_CONVERGED;
+  return osc::isConverged(estimate, thresholds) ? StereoCalibration::STATE_CONVERGED
+                                                : StereoCalibration::STATE_CONVERGING;
 }
 
 StereoCalibration makeCalibrationMessage(const osc::CalibrationEstimate& estimate,

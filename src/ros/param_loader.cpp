@@ -184,9 +184,20 @@ RosConfig loadRosConfig(const ros::NodeHandle& nh, std::vector<std::string>* pro
   readNumber(nh, "save_interval", &config.save_interval, problems);
 
   readInt(nh, "min_tracked_points", &config.min_tracked_points, problems);
-  readNumber(nh, "converged_translation_3sigma", &config.converged_translation_3sigma, problems);
-  readNumber(nh, "converged_rotation_3sigma_deg", &config.converged_rotation_3sigma, problems,
+  readNumber(nh, "converged_3sigma_caml_translation", &config.converged.caml_translation, problems);
+  readNumber(nh, "converged_3sigma_caml_rotation_deg", &config.converged.caml_rotation, problems,
              kDegToRad);
+  readNumber(nh, "converged_3sigma_camr_translation", &config.converged.camr_translation, problems);
+  readNumber(nh, "converged_3sigma_camr_rotation_deg", &config.converged.camr_rotation, problems,
+             kDegToRad);
+  for (const char* old : {"converged_translation_3sigma", "converged_rotation_3sigma_deg"}) {
+    if (nh.hasParam(old)) {
+      problems->push_back(std::string(old) +
+                          " was split per block: set converged_3sigma_caml_translation, "
+                          "converged_3sigma_caml_rotation_deg, converged_3sigma_camr_translation "
+                          "and converged_3sigma_camr_rotation_deg instead (docs/ros.md)");
+    }
+  }
   readNumber(nh, "min_rate", &config.min_rate, problems);
   readNumber(nh, "max_rate", &config.max_rate, problems);
   for (const std::string& problem : config.validate()) problems->push_back(problem);

@@ -34,8 +34,10 @@ std::vector<std::string> RosConfig::validate() const {
   checkPositive("motion_wait", motion_wait, &problems, true);
   checkPositive("tf_guess_timeout", tf_guess_timeout, &problems, true);
   checkPositive("save_interval", save_interval, &problems, true);
-  checkPositive("converged_translation_3sigma", converged_translation_3sigma, &problems);
-  checkPositive("converged_rotation_3sigma_deg", converged_rotation_3sigma, &problems);
+  checkPositive("converged_3sigma_caml_translation", converged.caml_translation, &problems);
+  checkPositive("converged_3sigma_caml_rotation_deg", converged.caml_rotation, &problems);
+  checkPositive("converged_3sigma_camr_translation", converged.camr_translation, &problems);
+  checkPositive("converged_3sigma_camr_rotation_deg", converged.camr_rotation, &problems);
   checkPositive("min_rate", min_rate, &problems);
   checkPositive("max_rate", max_rate, &problems);
   if (min_rate > max_rate) problems.push_back("min_rate must not exceed max_rate");

@@ -226,18 +226,43 @@ TEST(RestoredCovariance, TangentCovarianceMapsBackToTheFilesParameterCovariance)
   EXPECT_GT((T - P).cwiseAbs().maxCoeff(), 1e-6 * P.cwiseAbs().maxCoeff());
 }
 
-TEST(CalibrationState, FollowsPointsAndThresholds) {
+TEST(CalibrationState, FollowsPointsAndPerBlockThresholds) {
+  osc::CalibrationEstimate estimate;
+  estimate.tracked_points = 50;
+  estimate.parameter_covariance = osc::Matrix12d::Identity() * 1e-8;  // 3 sigma 0.3 mm / mrad
+  osc::ConvergenceThresholds bounds;                                  // the shipped ones
+  EXPECT_EQ(calibrationState(estimate, false, 10, bounds), StereoCalibration::STATE_CONVERGED);
+  EXPECT_EQ(calibrationState(estimate, true, 10, bounds), StereoCalibration::STATE_DIVERGED);
+  estimate.tracked_points = 3;
+  EXPECT_EQ(calibrationState(estimate, false, 10, bounds), StereoCalibration::STATE_INITIALIZING);
+  estimate.tracked_points = 50;
+  // Each block against its own bound: 3 sigma of 4 cm passes for xl (5 cm), not for xr (3 mm).
+  estimate.parameter_covariance(0, 0) = std::pow(0.04 / 3.0, 2);
+  EXPECT_EQ(calibrationState(estimate, false, 10, bounds), StereoCalibration::STATE_CONVERGED);
+  estimate.parameter_covariance(6, 6) = std::pow(0.004 / 3.0, 2);
+  EXPECT_EQ(calibrationState(estimate, false, 10, bounds), StereoCalibration::STATE_CONVERGING);
+  estimate.parameter_covariance(6, 6) = 1e-8;
+  estimate.parameter_covariance(9, 9) = std::pow(0.06 * M_PI / 180.0 / 3.0, 2);  // roll_r
+  EXPECT_EQ(calibrationState(estimate, false, 10, bounds), StereoCalibration::STATE_CONVERGING);
+}
+
+// Issue 14: what the motion cannot determine is reported and does not block CONVERGED, while
+// a wide parameter that the motion does determine still does.
+TEST(CalibrationState, UndeterminedTranslationsDoNotBlockConverged) {
   osc::CalibrationEstimate estimate;
   estimate.tracked_points = 50;
   estimate.parameter_covariance = osc::Matrix12d::Identity() * 1e-8;
-  EXPECT_EQ(calibrationState(estimate, false, 10, 0.01, 0.01), StereoCalibration::STATE_CONVERGED);
-  EXPECT_EQ(calibrationState(estimate, true, 10, 0.01, 0.01), StereoCalibration::STATE_DIVERGED);
-  estimate.tracked_points = 3;
-  EXPECT_EQ(calibrationState(estimate, false, 10, 0.01, 0.01),
-            StereoCalibration::STATE_INITIALIZING);
-  estimate.tracked_points = 50;
-  estimate.parameter_covariance(9, 9) = 1.0;
-  EXPECT_EQ(calibrationState(estimate, false, 10, 0.01, 0.01), StereoCalibration::STATE_CONVERGING);
+  estimate.parameter_covariance(2, 2) = 0.5 * 0.5;  // zl still at its start sigma
+  osc::ConvergenceThresholds bounds;
+  estimate.excitation << 0.0, 0.02, 0.9;  // a car on a flat road: yaw only
+  EXPECT_EQ(osc::undeterminedParameters(estimate, bounds), std::vector<int>{2});
+  EXPECT_EQ(calibrationState(estimate, false, 10, bounds), StereoCalibration::STATE_CONVERGED);
+  estimate.excitation << 0.6, 0.0, 0.9;  // rolling: zl is determined, and not yet learned
+  EXPECT_TRUE(osc::undeterminedParameters(estimate, bounds).empty());
+  EXPECT_EQ(calibrationState(estimate, false, 10, bounds), StereoCalibration::STATE_CONVERGING);
+  // Standing still: nothing rotates, but xl and yl, already learned, are not listed.
+  estimate.excitation.setZero();
+  EXPECT_EQ(osc::undeterminedParameters(estimate, bounds), std::vector<int>{2});
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include "online_stereo_calibration/StereoCalibration.h"
 #include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
+#include "online_stereo_calibration/core/estimator/convergence.h"
 
 namespace online_stereo_calibration {
 
@@ -26,10 +27,11 @@ struct OutputFrames {
   std::string right_optical;  ///< right optical frame
 };
 
-/// INITIALIZING / CONVERGING / CONVERGED / DIVERGED (StereoCalibration.msg).
+/// INITIALIZING / CONVERGING / CONVERGED / DIVERGED (StereoCalibration.msg). CONVERGED:
+/// osc::isConverged.
 /// @param jump_detected the filter reported a sudden calibration change in this step.
 uint8_t calibrationState(const osc::CalibrationEstimate& estimate, bool jump_detected,
-                         int min_tracked_points, double translation_3sigma, double rotation_3sigma);
+                         int min_tracked_points, const osc::ConvergenceThresholds& thresholds);
 
 /// The ~calibration message of one estimate (pure: the transforms are computed from the
 /// estimate's extrinsics under interface.md's conventions).

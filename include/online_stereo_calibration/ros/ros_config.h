@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "online_stereo_calibration/core/estimator/convergence.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 
 namespace online_stereo_calibration {
@@ -52,9 +53,10 @@ struct RosConfig {
   bool resume = false;            ///< start from calibration_file (guess and sigmas) if it exists
   double save_interval = 60.0;    ///< s between periodic saves (0 = only on shutdown/service)
 
-  int min_tracked_points = 10;                 ///< fewer points: INITIALIZING, diagnostics warn
-  double converged_translation_3sigma = 0.02;  ///< m, 3-sigma bound of every translation
-  double converged_rotation_3sigma = 0.2 * 0.0174532925199432958;  ///< rad, of every angle
+  int min_tracked_points = 10;  ///< fewer points: INITIALIZING, diagnostics warn
+  /// CONVERGED: every parameter's 3-sigma below these (per block; values a good drive
+  /// reaches: docs/ros.md), except x_caml translations the motion does not determine.
+  osc::ConvergenceThresholds converged;
   double min_rate = 1.0;    ///< Hz, input rates below are warned about
   double max_rate = 100.0;  ///< Hz, input rates above are warned about
 

@@ -137,6 +137,7 @@ CalibrationEstimate StereoCalibrationEstimator::estimate() const {
   e.tangent_covariance = filter_.covariance();
   e.parameter_covariance = filter_.parameterCovariance();
   e.tracked_points = filter_.pointCount();
+  e.excitation = filter_.excitationGains();
   return e;
 }
 

@@ -34,6 +34,15 @@ Eigen::Vector3d MotionExcitation::gains() const {
   return gain;
 }
 
+std::array<bool, 3> unexcitedTranslationAxes(const Eigen::Vector3d& gains, double min_gain) {
+  std::array<bool, 3> unexcited{};
+  for (int axis = 0; axis < 3; ++axis) {
+    const double other = std::max(gains((axis + 1) % 3), gains((axis + 2) % 3));
+    unexcited[static_cast<size_t>(axis)] = !(other >= min_gain);
+  }
+  return unexcited;
+}
+
 Eigen::Matrix3d MotionExcitation::excitedRotation(const Eigen::Matrix3d& R_prev_curr) const {
   if (!enabled()) return R_prev_curr;
   return expSO3(gains().cwiseProduct(logSO3(R_prev_curr)));

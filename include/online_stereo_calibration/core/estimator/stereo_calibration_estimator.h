@@ -25,6 +25,9 @@ struct CalibrationEstimate {
   Matrix12d parameter_covariance = Matrix12d::Zero();  ///< of parameters
   Matrix12d tangent_covariance = Matrix12d::Zero();    ///< of the filter's manifold error
   size_t tracked_points = 0;
+  /// MotionExcitation gains of the recent vehicle rotation (roll, pitch, yaw), in [0, 1]:
+  /// which parts of x_caml the current motion can determine (unexcitedTranslationAxes).
+  Eigen::Vector3d excitation = Eigen::Vector3d::Ones();
 
   /// 1-sigma of each parameter (sqrt of the covariance diagonal).
   Vector12d sigmas() const { return parameter_covariance.diagonal().cwiseMax(0.0).cwiseSqrt(); }

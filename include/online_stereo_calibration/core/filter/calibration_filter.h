@@ -104,6 +104,8 @@ class CalibrationFilter {
   /// regressions on the block no longer hold). Returns the removed points' ids.
   std::vector<PointId> reopen(JumpBlock block, double translation_sigma, double rotation_sigma);
   size_t pointCount() const { return points_.size(); }
+  /// How much of the recent vehicle rotation is excitation, per axis (MotionExcitation).
+  Eigen::Vector3d excitationGains() const { return excitation_.gains(); }
 
   const StereoExtrinsics& extrinsics() const { return extrinsics_; }
   /// Covariance of the tangent error [dt_l, dtheta_l, dt_r, dtheta_r] (pose.h boxPlus).

@@ -12,6 +12,8 @@
 /// strongly excited axis is used as measured.
 #pragma once
 
+#include <array>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -43,5 +45,12 @@ class MotionExcitation {
   /// Running mean square of the rotation per axis, per reference period (rad^2).
   Eigen::Vector3d mean_square_ = Eigen::Vector3d::Zero();
 };
+
+/// Which of x_caml's translation axes (vehicle x, y, z) the recent motion does not determine.
+/// The camera position enters the prediction only through (R_motion^T - I) t_l (eq. 8), so a
+/// rotation about one axis shows the position along the other two: zl needs roll or pitch,
+/// yl roll or yaw, xl pitch or yaw. An axis counts as excited with a MotionExcitation gain of
+/// at least @p min_gain. @p gains: roll, pitch, yaw.
+std::array<bool, 3> unexcitedTranslationAxes(const Eigen::Vector3d& gains, double min_gain = 0.1);
 
 }  // namespace osc
