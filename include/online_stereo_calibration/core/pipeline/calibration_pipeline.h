@@ -94,9 +94,10 @@ class CalibrationPipeline {
   /// (a knocked right camera) from the second in a row.
   bool lostTheStereoGeometry(const FrontEndStatistics& stats);
   /// After lostTheStereoGeometry: fits the pair's epipolar geometry over the whole images
-  /// (fitStereoGeometry) and counts fits whose rotation is more than kKnockSigmas combined
-  /// sigmas (and 0.05 deg) from x_camr's; true from the second in a row, with 3 times that
-  /// angle as the rotation sigma to re-open with. @p status says what was seen.
+  /// (fitStereoGeometry) and counts fits whose rotation across the epipolar lines (about the
+  /// optical x and z axes) is more than kKnockSigmas combined sigmas (and 0.05 deg) from
+  /// x_camr's; true from the second in a row, with 3 times that angle as the rotation sigma
+  /// to re-open with. @p status says what was seen.
   bool wholeImageFitContradicts(double* rotation_sigma, std::string* status);
   /// Counts pairs whose refined pairs lie off their epipolar lines (EpipolarTrend) by an angle
   /// of more than kKnockSigmas x_camr rotation sigmas; true from the second in a row, with

@@ -1,0 +1,136 @@
+/// @file test_kitti.cpp
+/// @brief Real images and real motion: the KITTI stretches of ../shared/data/kitti_odometry_51
+/// through the CalibrationPipeline, the right camera started 0.5 deg (each angle) and 5 cm
+/// (baseline) off, the left camera at its truth (zero, with the default start sigmas).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "online_stereo_calibration/core/frontend/feature_detection.h"
+#include "online_stereo_calibration/core/frontend/front_end_config.h"
+#include "online_stereo_calibration/core/frontend/global_stereo_fit.h"
+#include "online_stereo_calibration/core/geometry/rotation.h"
+#include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
+#include "online_stereo_calibration/tools/kitti_sequence.h"
+
+namespace osc {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+const std::string kKittiDir = std::string(OSC_SOURCE_DIR) + "/../shared/data/kitti_odometry_51";
+
+/// Per-frame errors (estimate - truth, angles wrapped) and sigmas of one run.
+struct KittiRun {
+  std::vector<Vector12d> errors, sigmas;
+  std::vector<int> points;
+};
+
+KittiRun runKitti(const KittiSequence& sequence, const Vector12d& start_error) {
+  const Vector12d truth = sequence.truth();
+  CalibrationPipeline pipeline(FilterConfig(), FrontEndConfig(), sequence.left, sequence.right,
+                               StereoExtrinsics::fromParameters(truth + start_error));
+  KittiRun run;
+  for (int k = 0; k < sequence.frames(); ++k) {
+    const cv::Mat left =
+        cv::imread(sequence.left_images[static_cast<size_t>(k)], cv::IMREAD_GRAYSCALE);
+    const cv::Mat right =
+        cv::imread(sequence.right_images[static_cast<size_t>(k)], cv::IMREAD_GRAYSCALE);
+    const PipelineResult r =
+        pipeline.process(left, right, k > 0 ? sequence.motion(k) : MotionIncrement());
+    EXPECT_TRUE(r.processed) << "frame " << k << ": " << r.status;
+    Vector12d e = r.estimate.parameters - truth;
+    for (int i = 0; i < 12; ++i) {
+      if (i % 6 >= 3) e(i) = std::atan2(std::sin(e(i)), std::cos(e(i)));
+    }
+    run.errors.push_back(e);
+    run.sigmas.push_back(r.estimate.sigmas());
+    run.points.push_back(static_cast<int>(r.estimate.tracked_points));
+  }
+  return run;
+}
+
+// What holds today on real images (measured at this commit, docs/RESULTS.md "KITTI"): from
+// 0.5 deg / 5 cm off, x_camr comes within 0.07-0.09 deg and 7 mm of KITTI's rig in 5 frames
+// and stays there, every pair processed with 50-75 points. Not asserted, because it is not
+// true yet (issues 14 and 15): that it is honest. The sigmas are 0.003-0.005 deg, so
+// roll_r is 14-20 sigma and yaw_r up to 31 sigma off, also when started at the truth.
+TEST(Kitti, RightCameraComesNearKittisRigFromHalfADegreeOff) {
+  if (!std::ifstream(kKittiDir + "/seq1/calib.txt").good()) {
+    GTEST_SKIP() << "KITTI data not found at " << kKittiDir;
+  }
+  for (const char* seq : {"seq1", "seq2"}) {
+    const KittiSequence sequence = readKittiSequence(kKittiDir + "/" + seq);
+    ASSERT_EQ(sequence.frames(), 51);
+    EXPECT_NEAR(sequence.baseline, 0.537, 0.001);
+    Vector12d start = Vector12d::Zero();
+    start(7) = 0.05;
+    start.tail<3>().setConstant(0.5 * kDeg);
+    const KittiRun run = runKitti(sequence, start);
+    for (size_t k = 10; k < run.errors.size(); ++k) {
+      const Vector12d& e = run.errors[k];
+      EXPECT_LT(std::abs(e(7)), 0.015) << seq << " frame " << k;
+      for (int i = 9; i < 12; ++i) EXPECT_LT(std::abs(e(i)), 0.15 * kDeg) << seq << " " << k;
+      EXPECT_GE(run.points[k], 30) << seq << " frame " << k;
+    }
+  }
+}
+
+TEST(Kitti, MissingFolderIsNamed) {
+  try {
+    readKittiSequence("/nonexistent/seq9");
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/seq9/calib.txt"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Kitti, DISABLED_Diagnostic) {
+  for (const char* seq : {"seq1", "seq2"}) {
+    const KittiSequence sequence = readKittiSequence(kKittiDir + "/" + seq);
+    // D_ANGLE (deg, each x_camr angle) and D_YR (m) override the start error.
+    Vector12d start = Vector12d::Zero();
+    start(7) = std::getenv("D_YR") ? std::atof(std::getenv("D_YR")) : 0.05;
+    start.tail<3>().setConstant((std::getenv("D_ANGLE") ? std::atof(std::getenv("D_ANGLE")) : 0.5) *
+                                kDeg);
+    const KittiRun run = runKitti(sequence, start);
+    for (size_t k = 0; k < run.errors.size(); k += 5) {
+      const Vector12d& e = run.errors[k];
+      const Vector12d& s = run.sigmas[k];
+      std::printf(
+          "%s %2zu pts %3d | xl %+.3f(%.3f) yl %+.3f(%.3f) zl %+.3f(%.3f) yaw_l %+.3f(%.3f) | yr "
+          "%+.4f(%.4f) roll_r %+.3f(%.3f) pitch_r %+.3f(%.3f) yaw_r %+.3f(%.3f)\n",
+          seq, k, run.points[k], e(0), s(0), e(1), s(1), e(2), s(2), e(5) / kDeg, s(5) / kDeg, e(7),
+          s(7), e(9) / kDeg, s(9) / kDeg, e(10) / kDeg, s(10) / kDeg, e(11) / kDeg, s(11) / kDeg);
+    }
+  }
+}
+
+TEST(Kitti, DISABLED_WholeImageFit) {
+  for (const char* seq : {"seq1", "seq2"}) {
+    const KittiSequence sequence = readKittiSequence(kKittiDir + "/" + seq);
+    const CameraModel left(sequence.left), right(sequence.right);
+    const FeatureDetector detector{FrontEndConfig()};
+    for (int k = 0; k < sequence.frames(); k += 10) {
+      const GlobalStereoFit fit = fitStereoGeometry(
+          detector.detect(cv::imread(sequence.left_images[k], cv::IMREAD_GRAYSCALE), left),
+          detector.detect(cv::imread(sequence.right_images[k], cv::IMREAD_GRAYSCALE), right), left,
+          right, Eigen::Vector3d::UnitX());
+      // Optical axes: x right (pitch_r is about -y_body = ... print the optical rotation vector).
+      const Eigen::Vector3d w = logSO3(fit.R_lopt_ropt) / kDeg;
+      std::printf("%s %2d %s: optical rotation vector [%+.4f %+.4f %+.4f] deg, sigma %.4f\n", seq,
+                  k, fit.why.c_str(), w.x(), w.y(), w.z(),
+                  std::sqrt(fit.rotation_covariance.diagonal().maxCoeff()) / kDeg);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace osc
