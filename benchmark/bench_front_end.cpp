@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "online_stereo_calibration/core/frontend/global_stereo_fit.h"
 #include "online_stereo_calibration/core/frontend/stereo_front_end.h"
 #include "online_stereo_calibration/core/sim/measurement_simulator.h"
 #include "online_stereo_calibration/core/sim/stereo_scene_renderer.h"
@@ -159,6 +160,38 @@ void BM_WholeFrame(benchmark::State& state) {
   state.counters["points"] = points / static_cast<double>(state.iterations());
 }
 BENCHMARK(BM_WholeFrame)->Apply(imageSizesWithAndWithoutSearch)->Unit(benchmark::kMillisecond);
+
+/// The whole-image stereo fit (issue 14) on the keypoints the front end detected in a pair:
+/// it runs only after two pairs without any stereo pair, so this is its cost when it runs.
+void BM_WholeImageStereoFit(benchmark::State& state) {
+  const Drive& d = drive(static_cast<int>(state.range(0)));
+  Replay replay(d, FrontEndConfig());
+  double inliers = 0.0, features = 0.0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const size_t i = replay.next();
+    const auto observations = replay.frontEnd().observe(d.left[i], d.right[i], d.motion[i],
+                                                        replay.estimator().filter(), nullptr);
+    state.ResumeTiming();
+    const GlobalStereoFit fit =
+        fitStereoGeometry(replay.frontEnd().lastLeftFeatures(),
+                          replay.frontEnd().lastRightFeatures(), replay.estimator().leftCamera(),
+                          replay.estimator().rightCamera(), Eigen::Vector3d::UnitX());
+    state.PauseTiming();
+    inliers += fit.inliers;
+    features += static_cast<double>(replay.frontEnd().lastLeftFeatures().size());
+    replay.finish(replay.estimator().processFrame(d.motion[i], observations));
+    state.ResumeTiming();
+  }
+  const double n = static_cast<double>(state.iterations());
+  state.counters["inliers"] = inliers / n;
+  state.counters["features"] = features / n;
+}
+BENCHMARK(BM_WholeImageStereoFit)
+    ->Arg(640)
+    ->Arg(1280)
+    ->ArgName("width")
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace osc

@@ -23,22 +23,28 @@ struct Nearest {
   double second_distance = std::numeric_limits<double>::infinity();
 };
 
-std::vector<Nearest> nearestNeighbours(const FeatureSet& from, const FeatureSet& to) {
-  std::vector<Nearest> nearest(from.size());
-  for (size_t i = 0; i < from.size(); ++i) {
-    Nearest& n = nearest[i];
-    for (size_t j = 0; j < to.size(); ++j) {
-      const double d = from.distance(static_cast<int>(i), to, static_cast<int>(j));
-      if (d < n.best_distance) {
-        n.second_distance = n.best_distance;
-        n.best_distance = d;
-        n.best = static_cast<int>(j);
-      } else if (d < n.second_distance) {
-        n.second_distance = d;
-      }
+void keep(Nearest* n, int index, double d) {
+  if (d < n->best_distance) {
+    n->second_distance = n->best_distance;
+    n->best_distance = d;
+    n->best = index;
+  } else if (d < n->second_distance) {
+    n->second_distance = d;
+  }
+}
+
+/// Nearest and second-nearest neighbours in both directions from one pass over all pairs.
+void nearestNeighbours(const FeatureSet& left, const FeatureSet& right,
+                       std::vector<Nearest>* left_to_right, std::vector<Nearest>* right_to_left) {
+  left_to_right->assign(left.size(), Nearest());
+  right_to_left->assign(right.size(), Nearest());
+  for (size_t i = 0; i < left.size(); ++i) {
+    for (size_t j = 0; j < right.size(); ++j) {
+      const double d = left.distance(static_cast<int>(i), right, static_cast<int>(j));
+      keep(&(*left_to_right)[i], static_cast<int>(j), d);
+      keep(&(*right_to_left)[j], static_cast<int>(i), d);
     }
   }
-  return nearest;
 }
 
 /// Undistorted pixel (K * normalised) -> normalised image coordinates.
@@ -120,8 +126,8 @@ GlobalStereoFit fitStereoGeometry(const FeatureSet& left, const FeatureSet& righ
     return fit;
   }
   // Mutual best matches that pass the distance bound and the ratio test in both directions.
-  const std::vector<Nearest> left_to_right = nearestNeighbours(left, right);
-  const std::vector<Nearest> right_to_left = nearestNeighbours(right, left);
+  std::vector<Nearest> left_to_right, right_to_left;
+  nearestNeighbours(left, right, &left_to_right, &right_to_left);
   const Eigen::Matrix3d Kl_inv = left_camera.K().inverse(), Kr_inv = right_camera.K().inverse();
   std::vector<cv::Point2d> points_left, points_right;
   for (size_t i = 0; i < left.size(); ++i) {
