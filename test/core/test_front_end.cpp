@@ -29,6 +29,7 @@
 #include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
 #include "online_stereo_calibration/core/sim/image_scenario_runner.h"
 #include "online_stereo_calibration/core/sim/measurement_simulator.h"
+#include "online_stereo_calibration/tools/kitti_sequence.h"
 
 namespace osc {
 namespace {
@@ -609,13 +610,6 @@ EurocCamera readEurocCamera(const std::string& file) {
   return c;
 }
 
-std::vector<std::string> pngs(const std::string& dir) {
-  std::vector<cv::String> files;
-  cv::glob(dir + "/*.png", files, false);
-  std::vector<std::string> out(files.begin(), files.end());
-  std::sort(out.begin(), out.end());
-  return out;
-}
 
 TEST(FrontEndEuroc, EpipolarGuidedMatchingOnRealImages) {
   if (!std::ifstream(kEurocDir + "/cam0/sensor.yaml").good()) {
@@ -637,8 +631,8 @@ TEST(FrontEndEuroc, EpipolarGuidedMatchingOnRealImages) {
                                reference);
   const CameraModel left(cam0.intrinsics), right(cam1.intrinsics);
   const Eigen::Matrix3d F = fundamentalMatrix(left.K(), right.K(), T_lopt_ropt);
-  const std::vector<std::string> left_files = pngs(kEurocDir + "/cam0");
-  const std::vector<std::string> right_files = pngs(kEurocDir + "/cam1");
+  const std::vector<std::string> left_files = sortedPngs(kEurocDir + "/cam0");
+  const std::vector<std::string> right_files = sortedPngs(kEurocDir + "/cam1");
   ASSERT_EQ(left_files.size(), right_files.size());
   ASSERT_GE(left_files.size(), 4u);
   for (size_t i = 0; i < 4; ++i) {
@@ -681,8 +675,8 @@ TEST(GlobalStereoFit, RecoversTheRigOfRealEurocPairsWithoutACalibration) {
   const Eigen::Isometry3d T_lopt_ropt = cam0.T_body_sensor.inverse() * cam1.T_body_sensor;
   const CameraModel left(cam0.intrinsics), right(cam1.intrinsics);
   const FeatureDetector detector{FrontEndConfig()};
-  const std::vector<std::string> left_files = pngs(kEurocDir + "/cam0");
-  const std::vector<std::string> right_files = pngs(kEurocDir + "/cam1");
+  const std::vector<std::string> left_files = sortedPngs(kEurocDir + "/cam0");
+  const std::vector<std::string> right_files = sortedPngs(kEurocDir + "/cam1");
   ASSERT_GE(left_files.size(), 4u);
   for (size_t i = 0; i < 4; ++i) {
     const size_t k = i * left_files.size() / 4;

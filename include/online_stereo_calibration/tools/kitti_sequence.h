@@ -33,6 +33,9 @@ struct KittiSequence {
   MotionIncrement motion(int k) const;
 };
 
+/// The *.png files of @p folder, sorted by name (frame order for KITTI and EuRoC folders).
+std::vector<std::string> sortedPngs(const std::string& folder);
+
 /// Reads a sequence folder. @throws std::runtime_error naming the file and what is wrong
 /// (missing, unreadable, a line without 12 numbers, image and pose counts that differ).
 KittiSequence readKittiSequence(const std::string& folder);

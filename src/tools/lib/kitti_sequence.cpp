@@ -37,15 +37,15 @@ std::vector<std::array<double, 12>> readMatrices(const std::string& path) {
   return rows;
 }
 
-std::vector<std::string> pngsIn(const std::string& folder) {
+}  // namespace
+
+std::vector<std::string> sortedPngs(const std::string& folder) {
   std::vector<cv::String> files;
   cv::glob(folder + "/*.png", files, false);
   std::vector<std::string> out(files.begin(), files.end());
   std::sort(out.begin(), out.end());
   return out;
 }
-
-}  // namespace
 
 Vector12d KittiSequence::truth() const {
   Vector12d p = Vector12d::Zero();
@@ -73,8 +73,8 @@ KittiSequence readKittiSequence(const std::string& folder) {
     }
     s.T_first_lopt.push_back(T);
   }
-  s.left_images = pngsIn(folder + "/image_l");
-  s.right_images = pngsIn(folder + "/image_r");
+  s.left_images = sortedPngs(folder + "/image_l");
+  s.right_images = sortedPngs(folder + "/image_r");
   if (s.left_images.size() != s.T_first_lopt.size() ||
       s.right_images.size() != s.T_first_lopt.size()) {
     throw std::runtime_error("KITTI: " + folder + ": " + std::to_string(s.left_images.size()) +
