@@ -26,7 +26,7 @@ debian_ros=(
   ros-base-dev catkin ros-message-generation python3-catkin-pkg
   libnodeletlib-dev libtf2-ros-dev libtf2-eigen-dev libtf2-geometry-msgs-dev
   libcv-bridge-dev libmessage-filters-dev libimage-transport-dev libdiagnostic-updater-dev
-  librosbag-dev librostest-dev python3-rosbag python3-rostest
+  librosbag-dev librostest-dev python3-rosbag python3-rostest rosbash
   libstd-srvs-dev libnav-msgs-dev libvisualization-msgs-dev
   rviz
 )
@@ -37,6 +37,7 @@ noetic_ros=(
   ros-noetic-nodelet ros-noetic-tf2-ros ros-noetic-tf2-eigen ros-noetic-tf2-geometry-msgs
   ros-noetic-cv-bridge ros-noetic-message-filters ros-noetic-image-transport
   ros-noetic-diagnostic-updater ros-noetic-rosbag ros-noetic-rostest ros-noetic-rosunit
+  ros-noetic-rosbash
   ros-noetic-sensor-msgs ros-noetic-geometry-msgs ros-noetic-nav-msgs ros-noetic-std-srvs
   ros-noetic-visualization-msgs ros-noetic-diagnostic-msgs
   ros-noetic-rviz
