@@ -32,8 +32,6 @@
 # message), OSC_REL_FRAMES (default 300).
 # Default run: about 2 min on a 2-core machine.
 set -euo pipefail
-# shellcheck source=scripts/reliability/common.sh
-source "$(dirname "$0")/common.sh"
 
 KILLS=18
 SEED=17
@@ -55,6 +53,9 @@ while (($#)); do
 done
 [[ "$KILLS" =~ ^[0-9]+$ ]] || { echo "kill_resume.sh: --kills must be an integer" >&2; exit 2; }
 [[ "$SEED" =~ ^[0-9]+$ ]] || { echo "kill_resume.sh: --seed must be an integer" >&2; exit 2; }
+set --  # (catkin's setup.bash, sourced by common.sh, would read our options)
+# shellcheck source=scripts/reliability/common.sh
+source "$(dirname "$0")/common.sh"
 
 trap rel_cleanup EXIT
 trap 'exit 130' INT TERM

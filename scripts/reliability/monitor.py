@@ -171,7 +171,8 @@ def cmd_soak(args):
     from rosgraph_msgs.msg import Clock
     decode = Decoder()
     lock = threading.Lock()
-    done = threading.Event()
+    done = threading.Event()     # /clock ended the last loop
+    stopped = threading.Event()  # 1 s later: counting stops (late messages still count)
     n = args.loops
     loops = [{"messages": 0, "nan": 0, "statuses": 0, "levels": {}, "states": {},
               "status_stamps": [],
@@ -222,7 +223,7 @@ def cmd_soak(args):
     def on_calibration(raw):
         msg = decode(raw)
         with lock:
-            if done.is_set() or state["started"] is None:
+            if stopped.is_set() or state["started"] is None:
                 return
             stamp = msg.header.stamp.to_sec()
             k = loop_of("calibration", stamp)
@@ -245,7 +246,7 @@ def cmd_soak(args):
     def on_diagnostics(raw):
         msg = decode(raw)
         with lock:
-            if done.is_set() or state["started"] is None:
+            if stopped.is_set() or state["started"] is None:
                 return
             k = loop_of("diagnostics", msg.header.stamp.to_sec())
             if k >= n:
@@ -284,6 +285,9 @@ def cmd_soak(args):
                 args.timeout, state["loop"], n)
             break
         done.wait(0.2)
+    if done.is_set():
+        time.sleep(1.0)  # messages of the last loop still on their way
+    stopped.set()
 
     alive = rss_kib(args.pid) is not None
     wall = time.time() - (state["started"] or time.time())

@@ -21,10 +21,8 @@
 #
 # Environment: OSC_BUILD_DIR (default build), OSC_REL_OUT (default out/reliability: the drive
 # cache, and soak/ with the logs and soak.json), OSC_REL_FRAMES (default 300).
-# Default run: about 2 min on a 2-core machine (rendering the drive once: 30 s more).
+# Default run: about 1.5 min on a 2-core machine (rendering the drive the first time: 5 s more).
 set -euo pipefail
-# shellcheck source=scripts/reliability/common.sh
-source "$(dirname "$0")/common.sh"
 
 LOOPS=3
 PORT=""
@@ -41,6 +39,9 @@ while (($#)); do
   esac
 done
 [[ "$LOOPS" =~ ^[1-9][0-9]*$ ]] || { echo "soak.sh: --loops must be a positive integer" >&2; exit 2; }
+set --  # (catkin's setup.bash, sourced by common.sh, would read our options)
+# shellcheck source=scripts/reliability/common.sh
+source "$(dirname "$0")/common.sh"
 
 trap rel_cleanup EXIT
 trap 'exit 130' INT TERM
