@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,20 @@
 #include "online_stereo_calibration/core/geometry/pose.h"
 
 namespace osc {
+
+class PoseTrajectory;
+
+/// A stretch of drive time (s, 0 at frame 0).
+struct TimeSpan {
+  double start = 0.0;     ///< s, >= 0
+  double duration = 0.0;  ///< s, > 0
+};
+
+/// A stretch of frames, both ends included.
+struct FrameSpan {
+  int first = 0;  ///< >= 0
+  int last = 0;   ///< >= first
+};
 
 /// Smooth analytic vehicle motion (see VehicleTrajectory): constant forward speed along a
 /// sinusoidally steered path, plus sinusoidal roll, pitch and heave of the body.
@@ -35,6 +50,34 @@ struct VehicleMotionProfile {
   double heave_period = 1.7;
   /// True: roll = pitch = heave = 0 (on-road driving; zl is then unobservable).
   bool planar = false;
+  /// Stops (traffic lights, queues): over each span the vehicle stands still. It slows down
+  /// over stop_ramp seconds before the span and speeds up over stop_ramp after it; the whole
+  /// profile (steering, roll, pitch, heave) is frozen with it, as if its clock stood still.
+  /// Spans must not overlap (ramps included).
+  std::vector<TimeSpan> stops;
+  /// Length (s) of the smooth slow-down and speed-up around a stop, >= 0.
+  double stop_ramp = 1.0;
+};
+
+/// What real odometry gets wrong beyond the white noise of motion_*_noise: every error is 0 by
+/// default, so a scenario without them is unchanged (its own random stream, so enabling one
+/// does not change the track structure or the pixel noise).
+struct OdometryErrorModel {
+  /// Clock offset (s) of the odometry against the cameras: the motion reported between two
+  /// image pairs stamped t0 and t1 is the true motion between t0 + time_offset and
+  /// t1 + time_offset. |time_offset| <= 0.5.
+  double time_offset = 0.0;
+  /// Scale error of the measured translation: each increment's translation is multiplied by
+  /// (1 + scale_error). |scale_error| <= 0.2.
+  double scale_error = 0.0;
+  /// Steady-state std of a slowly varying bias of the measured angular rate (rad/s, per
+  /// axis); the bias times dt is added to each increment's rotation. >= 0.
+  double rotation_rate_bias = 0.0;
+  /// Steady-state std of a slowly varying bias of the measured velocity (m/s, per axis, in
+  /// the vehicle frame); the bias times dt is added to each increment's translation. >= 0.
+  double velocity_bias = 0.0;
+  /// Correlation time (s) of both biases (first-order Gauss-Markov processes), > 0.
+  double bias_correlation_time = 30.0;
 };
 
 /// One synthetic drive at the level of pixel measurements. Defaults: the seed's experiment
@@ -90,6 +133,21 @@ struct MeasurementScenario {
   double outlier_fraction = 0.0;
   /// Seed of all random streams; the same seed gives identical frames.
   unsigned seed = 1;
+  /// Errors of the measured motion beyond white noise (time offset, scale, biases).
+  OdometryErrorModel odometry_error;
+  /// Frames in which nothing can be tracked (a texture-poor view: sky, a uniform wall,
+  /// darkness): no observation, every track is lost. Spans must be in order and not overlap.
+  std::vector<FrameSpan> blind_frames;
+  /// Fraction of the born points that lie on moving objects, in [0, 1]: each such point
+  /// moves at a constant velocity of moving_point_speed (m/s) in a random horizontal direction.
+  double moving_point_fraction = 0.0;
+  /// Speed (m/s) of the points on moving objects, >= 0.
+  double moving_point_speed = 2.0;
+  /// A recorded trajectory (T_world_veh over time, e.g. a TUM file) that replaces `motion`
+  /// when set: frame k is taken at recorded_start_offset + k / rate_hz after its first stamp.
+  std::shared_ptr<const PoseTrajectory> recorded_trajectory;
+  /// s after the recorded trajectory's first stamp at which frame 0 is taken, >= 0.
+  double recorded_start_offset = 0.0;
 
   /// Every problem, each naming the field and the allowed range; empty if valid.
   std::vector<std::string> validate() const;
