@@ -33,6 +33,9 @@ const std::string kKittiDir = std::string(OSC_SOURCE_DIR) + "/../shared/data/kit
 struct KittiRun {
   std::vector<Vector12d> errors, sigmas;
   std::vector<int> points;
+  /// The estimator restarted from its current estimate at this pair (re-linearised, tracks
+  /// reset: FilterConfig::relinearization_*).
+  std::vector<bool> restarted;
 };
 
 KittiRun runKitti(const KittiSequence& sequence, const Vector12d& start_error,
@@ -56,6 +59,7 @@ KittiRun runKitti(const KittiSequence& sequence, const Vector12d& start_error,
     run.errors.push_back(e);
     run.sigmas.push_back(r.estimate.sigmas());
     run.points.push_back(static_cast<int>(r.estimate.tracked_points));
+    run.restarted.push_back(r.estimator.relinearized);
   }
   return run;
 }
@@ -79,9 +83,12 @@ TEST(Kitti, RightCameraComesNearKittisRigFromHalfADegreeOff) {
     const KittiRun run = runKitti(sequence, start);
     for (size_t k = 10; k < run.errors.size(); ++k) {
       const Vector12d& e = run.errors[k];
-      EXPECT_LT(std::abs(e(7)), 0.035) << seq << " frame " << k;
+      EXPECT_LT(std::abs(e(7)), 0.035) << seq << " frame " << k << " sigma " << run.sigmas[k](7);
       for (int i = 9; i < 12; ++i) EXPECT_LT(std::abs(e(i)), 0.15 * kDeg) << seq << " " << k;
-      EXPECT_GE(run.points[k], 30) << seq << " frame " << k;
+      // A restart (re-linearisation) resets the tracks: new points come from the next pair.
+      if (!run.restarted[k] && !run.restarted[k - 1]) {
+        EXPECT_GE(run.points[k], 30) << seq << " frame " << k;
+      }
     }
   }
 }

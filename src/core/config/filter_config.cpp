@@ -108,6 +108,14 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "rotation 1 sigma re-opened after a detected jump"),
       real("jump_translation_sigma_m", &C::jump_translation_sigma, 1.0, 0.0, 10.0,
            "translation 1 sigma re-opened after a detected jump"),
+      integer("relinearization_frames", &C::relinearization_frames, 0, 100000,
+              "frames between checks whether the estimate left its start (linearisation) "
+              "point; 0 = never restart"),
+      real("relinearization_threshold", &C::relinearization_threshold, 1.0, 0.0, 100.0,
+           "restart from the current estimate with the start's covariance when it moved more "
+           "than this many start sigmas"),
+      integer("max_relinearizations", &C::max_relinearizations, 0, 1000,
+              "restarts at most after one start or re-opening"),
   };
   return table;
 }

@@ -1,6 +1,8 @@
 #include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
 
+#include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace osc {
 namespace {
@@ -23,6 +25,88 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
       right_(right),
       filter_(config, stereoIntrinsics(left_, right_)) {
   filter_.reset(initial_guess);
+  anchorHere(JumpBlock::kNone, 0.0, 0.0);
+}
+
+void StereoCalibrationEstimator::anchorHere(JumpBlock block, double translation_sigma,
+                                            double rotation_sigma) {
+  anchor_ = LinearizationAnchor();
+  anchor_.extrinsics = filter_.extrinsics();
+  anchor_.covariance = filter_.covariance();
+  anchor_.blocks = {{block != JumpBlock::kLeftToRight, block != JumpBlock::kVehicleToLeft}};
+  anchor_.translation_sigma = translation_sigma;
+  anchor_.rotation_sigma = rotation_sigma;
+}
+
+double StereoCalibrationEstimator::movedSinceAnchor(int block) const {
+  if (!anchor_.blocks[static_cast<size_t>(block)]) return 0.0;
+  const StereoExtrinsics& now = filter_.extrinsics();
+  const Vector6d moved = block == 0 ? boxMinus(now.T_veh_caml, anchor_.extrinsics.T_veh_caml)
+                                    : boxMinus(now.T_caml_camr, anchor_.extrinsics.T_caml_camr);
+  // After a start every component is checked; after a re-opening only those re-opened (a
+  // rotation-only re-opening keeps the block's converged translation, whose small sigma any
+  // ordinary update moves it by).
+  const bool whole_start = anchor_.blocks[0] && anchor_.blocks[1];
+  double largest = 0.0;
+  for (int k = 0; k < 6; ++k) {
+    const double variance = anchor_.covariance(6 * block + k, 6 * block + k);
+    const double reopened = k < 3 ? anchor_.translation_sigma : anchor_.rotation_sigma;
+    if (!(variance > 0.0) || (!whole_start && !(reopened > 0.0))) continue;
+    largest = std::max(largest, std::abs(moved(k)) / std::sqrt(variance));
+  }
+  return largest;
+}
+
+bool StereoCalibrationEstimator::anchorIsLive() const {
+  return config_.relinearization_frames > 0 && anchor_.restarts < config_.max_relinearizations &&
+         anchor_.steps < (config_.max_relinearizations + 1) * config_.relinearization_frames;
+}
+
+bool StereoCalibrationEstimator::relinearizeIfMoved(FrameReport* report) {
+  if (!anchorIsLive()) return false;
+  ++anchor_.steps;
+  if (++anchor_.frames < config_.relinearization_frames) return false;
+  anchor_.frames = 0;
+  const std::array<double, 2> moved = {movedSinceAnchor(0), movedSinceAnchor(1)};
+  const std::array<bool, 2> restart = {moved[0] > config_.relinearization_threshold,
+                                       moved[1] > config_.relinearization_threshold};
+  if (!restart[0] && !restart[1]) return false;
+  // Restart at the current estimate: the points were initialised and the first updates
+  // linearised at a calibration now known to be far off, so their regressions on it (and
+  // the sigma they gave) do not hold. The moved block's uncertainty at the anchor comes back
+  // (the other block keeps what it learned), and the data shrink it again from a
+  // linearisation point near the truth.
+  for (const PointEstimate& p : filter_.points()) report->dropped.push_back(p.id);
+  const bool whole_start = anchor_.blocks[0] && anchor_.blocks[1];
+  if (whole_start && restart[0] && restart[1]) {
+    filter_.reset(filter_.extrinsics(), anchor_.covariance);
+  } else {
+    for (int block = 0; block < 2; ++block) {
+      if (!restart[static_cast<size_t>(block)]) continue;
+      double translation_sigma = anchor_.translation_sigma, rotation_sigma = anchor_.rotation_sigma;
+      if (whole_start) {  // the start's own sigmas of this block
+        const Vector6d variance = anchor_.covariance.diagonal().segment<6>(6 * block);
+        translation_sigma = std::sqrt(variance.head<3>().maxCoeff());
+        rotation_sigma = std::sqrt(variance.tail<3>().maxCoeff());
+      }
+      filter_.reopen(block == 0 ? JumpBlock::kVehicleToLeft : JumpBlock::kLeftToRight,
+                     translation_sigma, rotation_sigma);
+    }
+  }
+  anchor_.extrinsics = filter_.extrinsics();
+  anchor_.frames = 0;
+  ++anchor_.restarts;
+  report->relinearized = true;
+  std::ostringstream message;
+  message << "restarted from the current estimate (re-linearised): "
+          << (restart[0] && restart[1] ? "x_caml and x_camr"
+              : restart[0]             ? "x_caml"
+                                       : "x_camr")
+          << " moved " << std::max(restart[0] ? moved[0] : 0.0, restart[1] ? moved[1] : 0.0)
+          << " start sigmas from where the filter was started (restart " << anchor_.restarts
+          << " of at most " << config_.max_relinearizations << "); tracks reset";
+  report->warnings.push_back(message.str());
+  return true;
 }
 
 bool StereoCalibrationEstimator::toMeasurement(const StereoObservation& o,
@@ -78,6 +162,15 @@ FrameReport StereoCalibrationEstimator::processFrame(
       if (report.step.jump != JumpBlock::kNone) {
         report.warnings.push_back(report.step.message);
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());
+        // A jump found while a start is still being re-linearised is part of that start
+        // (a guess far off gates many points out): the start's anchor covers both blocks.
+        if (!anchorIsLive()) {
+          anchorHere(report.step.jump, config_.jump_translation_sigma, config_.jump_rotation_sigma);
+        }
+      } else if (relinearizeIfMoved(&report)) {
+        // Tracking starts afresh with the next pair, as after a start.
+        candidates.clear();
+        has_previous_frame_ = false;
       }
       if (report.step.covariance_repaired) {
         report.warnings.push_back(
@@ -85,7 +178,7 @@ FrameReport StereoCalibrationEstimator::processFrame(
       }
     }
   }
-  has_previous_frame_ = true;
+  if (!report.relinearized) has_previous_frame_ = true;
 
   // New points after the correction, so they start from the best calibration (Sec. II-A).
   for (const PointMeasurement& m : candidates) {
@@ -116,18 +209,22 @@ std::vector<PointId> StereoCalibrationEstimator::resetTracking() {
 
 std::vector<PointId> StereoCalibrationEstimator::reopenRightCameraRotation(double rotation_sigma) {
   has_previous_frame_ = false;
-  return filter_.reopen(JumpBlock::kLeftToRight, 0.0, rotation_sigma);
+  std::vector<PointId> dropped = filter_.reopen(JumpBlock::kLeftToRight, 0.0, rotation_sigma);
+  anchorHere(JumpBlock::kLeftToRight, 0.0, rotation_sigma);
+  return dropped;
 }
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
   filter_.reset(guess);
   has_previous_frame_ = false;
+  anchorHere(JumpBlock::kNone, 0.0, 0.0);
 }
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
                                        const Matrix12d& tangent_covariance) {
   filter_.reset(guess, tangent_covariance);
   has_previous_frame_ = false;
+  anchorHere(JumpBlock::kNone, 0.0, 0.0);
 }
 
 CalibrationEstimate StereoCalibrationEstimator::estimate() const {

@@ -368,7 +368,13 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   for (const PointInnovation* inn : used) {
     const MatrixXd PJt = P * inn->J.transpose();
     const Eigen::Matrix4d S = inn->J * PJt + inn->S0;
-    const MatrixXd K = PJt * S.inverse();
+    // Rounding over many sequential updates from a wide prior can leave S indefinite; such
+    // a point must not turn the whole state into NaN (it is skipped, its own update below
+    // uses S0 only).
+    const Eigen::LLT<Eigen::Matrix4d> S_llt(S);
+    if (S_llt.info() != Eigen::Success || !S.allFinite()) continue;
+    const MatrixXd K = S_llt.solve(PJt.transpose()).transpose();
+    if (!K.allFinite()) continue;
     dg += K * (inn->residual - inn->J * dg);
     P.noalias() -= K * PJt.transpose();
     nis_sum += inn->nis;

@@ -61,8 +61,11 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   result.estimator = estimator_->processFrame(motion_since_last_processed, observations);
   front_end_->commit(result.estimator, estimator_->filter());
   result.processed = true;
-  result.status =
-      result.estimator.motion_rejected ? "processed (motion rejected, tracks reset)" : "ok";
+  result.status = result.estimator.motion_rejected ? "processed (motion rejected, tracks reset)"
+                  : result.estimator.relinearized
+                      ? "processed (restarted from the current estimate: re-linearised, tracks "
+                        "reset)"
+                      : "ok";
   // A knocked right camera. Beyond the epipolar band of a converged x_camr no pair reaches
   // the filter, so its own jump test never sees one; within it the pairs reach it but, off
   // their lines by tens of its sigmas, are followed only through x_camr's slow drift noise.

@@ -84,6 +84,20 @@ struct FilterConfig {
   double jump_rotation_sigma = 10.0 * 0.0174532925199432958;  ///< rad, re-opened 1 sigma
   double jump_translation_sigma = 0.02;                       ///< m, re-opened 1 sigma
 
+  // --- re-linearisation after a start or a re-opening (issue 14) ---
+  /// Every this many frames after a start (or a re-opened block), the estimator compares the
+  /// estimate with the point the filter was started (linearised) at; 0 = never. A guess far
+  /// off (a few prior sigmas) gives new points and first updates linearised far from the
+  /// truth, which can lock the filter onto a wrong answer with a small sigma (x_camr angles
+  /// 5 deg off: 176 sigma wrong). Restarting from the current estimate with the start's
+  /// covariance, as an iterated filter re-linearises, avoids that.
+  int relinearization_frames = 15;
+  /// ... and restarts when some tangent component moved more than this many of the start's
+  /// 1 sigmas since then.
+  double relinearization_threshold = 0.5;
+  /// ... at most this many times after one start or re-opening.
+  int max_relinearizations = 4;
+
   /// Every problem found, each naming the parameter, its value and the allowed range.
   std::vector<std::string> validate() const;
 };

@@ -7,6 +7,7 @@
 /// and keeps the bookkeeping of one image pair at a time.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,9 @@ struct FrameReport {
   int invalid_observations = 0;  ///< non-finite pixels or sigmas
   /// Points no longer in the filter (lost, outliers, reset): a tracker should forget them.
   std::vector<PointId> dropped;
+  /// The filter was restarted from the current estimate with its start's covariance (it had
+  /// moved far from where it was linearised: FilterConfig::relinearization_*).
+  bool relinearized = false;
   std::vector<std::string> warnings;  ///< human-readable, one per problem
 };
 
@@ -74,13 +78,41 @@ class StereoCalibrationEstimator {
   const CameraModel& rightCamera() const { return right_; }
 
  private:
+  /// Where the filter was last started or a block re-opened (its linearisation point) and
+  /// with which covariance: what relinearizeIfMoved() compares with and restarts with.
+  struct LinearizationAnchor {
+    StereoExtrinsics extrinsics;
+    Matrix12d covariance = Matrix12d::Identity();
+    /// Blocks checked and restarted: both after a start, one after a re-opening.
+    std::array<bool, 2> blocks{{true, true}};
+    /// The re-opened block's sigmas (m, rad), to widen it again on a restart.
+    double translation_sigma = 0.0, rotation_sigma = 0.0;
+    int frames = 0;    ///< accepted steps since the anchor or the last check
+    int steps = 0;     ///< accepted steps since the start or re-opening (over restarts)
+    int restarts = 0;  ///< restarts since the start or re-opening
+  };
+
   bool toMeasurement(const StereoObservation& observation, PointMeasurement* measurement) const;
+  /// Anchors at the filter's state now (after a start or re-opening of @p block).
+  void anchorHere(JumpBlock block, double translation_sigma, double rotation_sigma);
+  /// Largest move since the anchor of a tangent component of @p block (0 x_caml, 1 x_camr)
+  /// that the anchor checks (all after a start, the re-opened ones after a re-opening), in
+  /// the anchor's 1 sigmas; 0 for a block the anchor does not check.
+  double movedSinceAnchor(int block) const;
+  /// The anchor is still checked: fewer than max_relinearizations restarts and
+  /// (max_relinearizations + 1) * relinearization_frames steps since the start or re-opening.
+  bool anchorIsLive() const;
+  /// Every relinearization_frames accepted steps: each anchored block that moved more than
+  /// relinearization_threshold is restarted from the current estimate with the anchor's
+  /// uncertainty; every point is dropped into report->dropped. True if it did.
+  bool relinearizeIfMoved(FrameReport* report);
 
   FilterConfig config_;
   CameraModel left_;
   CameraModel right_;
   CalibrationFilter filter_;
   bool has_previous_frame_ = false;
+  LinearizationAnchor anchor_;
 };
 
 }  // namespace osc
