@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -213,6 +214,37 @@ TEST(Start, FarOffRightCameraAnglesAreRelinearisedNotLockedIn) {
     worst_without = std::max(worst_without, old.max_z);
   }
   EXPECT_GT(worst_without, 30.0);  // the case the re-linearisation is for
+}
+
+// Issue 14: an 11 cm rig guessed at 1 cm (yr +0.1 m) gets no point at all (every stereo pair
+// triangulates out of range for some x_camr sigma point). It used to say nothing; the
+// estimator now says why, naming the baseline, while a guess 50 % off starts normally.
+TEST(Start, NoPointAtAllIsExplainedByTheBaseline) {
+  MeasurementScenario scenario = paperOffroadScenario();
+  scenario.frames = 3;
+  scenario.step_frame = -1;
+  scenario.truth(7) = -0.11;
+  for (const double yr_error : {0.1, 0.055}) {
+    scenario.initial_error(7) = yr_error;
+    MeasurementSimulator simulator(scenario);
+    StereoCalibrationEstimator estimator(FilterConfig(), scenario.left, scenario.right,
+                                         simulator.initialGuess());
+    SimulatedFrame frame;
+    std::string warnings;
+    while (simulator.nextFrame(&frame)) {
+      const FrameReport report = estimator.processFrame(frame.measured_motion, frame.observations);
+      simulator.dropTracks(report.dropped);
+      for (const std::string& w : report.warnings) warnings += w + "\n";
+    }
+    if (yr_error > 0.09) {
+      EXPECT_EQ(estimator.estimate().tracked_points, 0u);
+      EXPECT_NE(warnings.find("no point could be initialised"), std::string::npos) << warnings;
+      EXPECT_NE(warnings.find("baseline yr -0.01 m"), std::string::npos) << warnings;
+    } else {
+      EXPECT_GT(estimator.estimate().tracked_points, 50u);
+      EXPECT_EQ(warnings.find("no point could be initialised"), std::string::npos) << warnings;
+    }
+  }
 }
 
 // Gross outliers (wrong matches) must not drag the calibration.

@@ -7,6 +7,9 @@
 namespace osc {
 namespace {
 
+/// Fewest refused stereo pairs for which "no point could be initialised" is worth a warning.
+constexpr int kFewestPairsToExplain = 10;
+
 StereoIntrinsics stereoIntrinsics(const CameraModel& left, const CameraModel& right) {
   StereoIntrinsics k;
   k.K_left = left.K();
@@ -189,6 +192,19 @@ FrameReport StereoCalibrationEstimator::processFrame(
     } else {
       ++report.rejected_new_points;
     }
+  }
+  // Stereo pairs but not one point: the filter cannot learn anything (issue 14: an 11 cm rig
+  // guessed at 1 cm stayed at 0 points for 800 frames with no other sign). Say why.
+  if (filter_.pointCount() == 0 && report.rejected_new_points >= kFewestPairsToExplain &&
+      report.new_points == 0) {
+    const CalibrationEstimate e = estimate();
+    std::ostringstream message;
+    message << "no point could be initialised: none of " << report.rejected_new_points
+            << " stereo pairs triangulates within [" << config_.min_point_depth << ", "
+            << config_.max_point_depth << "] m with the current left->right estimate "
+            << "(baseline yr " << e.parameters(7) << " m, 1 sigma " << e.sigmas()(7)
+            << " m); check the baseline guess and initial_camr_translation_sigma_m";
+    report.warnings.push_back(message.str());
   }
   // A point re-initialised from this pair (after a jump or a motion reset) is not dropped.
   std::vector<PointId> still_dropped;
