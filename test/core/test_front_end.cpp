@@ -610,7 +610,6 @@ EurocCamera readEurocCamera(const std::string& file) {
   return c;
 }
 
-
 TEST(FrontEndEuroc, EpipolarGuidedMatchingOnRealImages) {
   if (!std::ifstream(kEurocDir + "/cam0/sensor.yaml").good()) {
     GTEST_SKIP() << "EuRoC data not found at " << kEurocDir;
@@ -795,12 +794,7 @@ TEST(FrontEndDiag, DISABLED_DumpWrongMatchesAndTracks) {
   if (std::getenv("D_BLUR")) options.render.blur_sigma = std::atof(std::getenv("D_BLUR"));
   if (std::getenv("D_FLICKER")) options.exposure_variation = std::atof(std::getenv("D_FLICKER"));
   SceneConfig scene = options.scene;
-  scene.path.clear();
-  const double duration = s.frames / s.rate_hz;
-  const double speed = std::max(s.motion.speed, 0.1);
-  const int samples = std::max(2, static_cast<int>(std::ceil(duration * speed)) + 1);
-  for (int i = 0; i <= samples; ++i)
-    scene.path.push_back(sim.trajectory().groundPosition(duration * i / samples));
+  scene.path = sim.groundTrack();
   const StereoSceneRenderer renderer(scene);
   DiagCtx c{&renderer, &sim.leftCamera(), &sim.rightCamera(), {}, {}};
   FrontEndConfig fe;
