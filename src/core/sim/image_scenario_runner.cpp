@@ -115,6 +115,9 @@ std::vector<ImageFrameResult> runImageScenario(
   std::unordered_map<PointId, Birth> births;
   std::vector<ImageFrameResult> results;
   results.reserve(static_cast<size_t>(scenario.frames));
+  // The pipeline wants the motion since the last pair it processed: a refused pair (e.g. the
+  // dark images of a blind frame) adds its motion to the next pair's.
+  std::optional<MotionIncrement> since_processed;
   SimulatedFrame frame;
   while (simulator.nextFrame(&frame)) {
     ImageFrameResult r;
@@ -138,9 +141,24 @@ std::vector<ImageFrameResult> runImageScenario(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - render_start)
             .count();
 
-    const PipelineResult result = pipeline.process(left, right, frame.measured_motion);
+    MotionIncrement motion = frame.measured_motion;
+    if (since_processed) {
+      motion.T_prev_curr = since_processed->T_prev_curr * motion.T_prev_curr;
+      motion.dt += since_processed->dt;
+    }
+    const PipelineResult result = pipeline.process(left, right, motion);
     r.processed = result.processed;
     r.front_end = result.front_end;
+    since_processed.reset();
+    if (!result.processed) {
+      // Nothing to check: the front end's lists are still the last processed pair's.
+      if (frame.index > 0) since_processed = motion;
+      r.filter =
+          makeFrameResult(frame, result.estimate, result.estimator, 1e3 * result.processing_time);
+      if (on_frame) on_frame(r, pipeline);
+      results.push_back(r);
+      continue;
+    }
 
     // Correctness against the renderer's ground truth.
     const StereoFrontEnd& front_end = pipeline.frontEnd();
