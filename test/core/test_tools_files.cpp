@@ -1175,6 +1175,35 @@ TEST(ScenarioFileCampaignKeys, TumTrajectoryBecomesTheMeasurementSimulatorsDrive
             std::string::npos);
 }
 
+TEST(ScenarioFileCampaignKeys, RealRecordedTrajectoryDrivesTheMeasurementSimulator) {
+  const std::string path =
+      std::string(OSC_SOURCE_DIR) + "/../shared/data/trajectories/udel_gore_rep103.tum";
+  if (!std::ifstream(path)) GTEST_SKIP() << "no " << path;
+  const SimulationScenario s = parseScenarioYaml(
+      "frames: 400\nrate_hz: 20\nstep_frame: -1\nodometry_error: {time_offset: 0.1}\n"
+      "motion_rotation_noise: 0\nmotion_translation_noise: 0\n"
+      "trajectory: {tum_file: " +
+          path + ", start_offset: 30}\n",
+      "udel.yaml", ".");
+  const PoseTrajectory file = readTumTrajectory(path);
+  MeasurementSimulator sim(s.measurement);
+  SimulatedFrame f;
+  int observed = 0;
+  while (sim.nextFrame(&f)) {
+    // The stamps are ~1.5e9 s: summed in another order they differ by ~1e-7 s (~1e-7 m).
+    const double stamp = file.firstStamp() + 30.0 + f.index / 20.0;
+    ASSERT_LT((f.T_world_veh.matrix() - file.at(stamp)->matrix()).norm(), 1e-5) << f.index;
+    if (f.index > 0) {
+      const Eigen::Isometry3d shifted =
+          file.at(stamp - 0.05 + 0.1)->inverse() * *file.at(stamp + 0.1);
+      ASSERT_LT((f.measured_motion.T_prev_curr.matrix() - shifted.matrix()).norm(), 1e-5)
+          << "frame " << f.index;
+    }
+    observed += static_cast<int>(f.observations.size());
+  }
+  EXPECT_GT(observed, 400 * 80);  // the points follow the walk
+}
+
 /// A small, fast image-level drive for the odometry and rendering checks.
 SimulationScenario smallDrive(const std::string& extra, int frames = 30) {
   return parseScenarioYaml(
