@@ -35,9 +35,7 @@ struct Drive {
     }
     MeasurementSimulator simulator(scenario);
     SceneConfig scene;
-    const double duration = kFrames / scenario.rate_hz;
-    for (int i = 0; i <= 10; ++i)
-      scene.path.push_back(simulator.trajectory().groundPosition(duration * i / 10.0));
+    scene.path = simulator.groundTrack();
     const StereoSceneRenderer renderer(scene);
     guess = simulator.initialGuess();
     SimulatedFrame frame;

@@ -74,9 +74,9 @@ fi
 simulator_sources=(src/core/sim include/online_stereo_calibration/core/sim
   src/core/geometry include/online_stereo_calibration/core/geometry
   src/tools/lib/drive_simulation.cpp src/tools/lib/scenario_file.cpp
-  src/tools/lib/pose_interpolation.cpp include/online_stereo_calibration/tools/scenario_file.h
+  src/tools/lib/tum_trajectory.cpp include/online_stereo_calibration/tools/scenario_file.h
   include/online_stereo_calibration/tools/drive_simulation.h
-  include/online_stereo_calibration/tools/pose_interpolation.h
+  include/online_stereo_calibration/tools/tum_trajectory.h
   src/tools/ros/simulate_main.cpp src/tools/ros/bag_io.h)
 stamp_of_drive() {
   {

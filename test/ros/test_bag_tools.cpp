@@ -19,8 +19,8 @@
 #include "online_stereo_calibration/tools/calibration_file.h"
 #include "online_stereo_calibration/tools/drive_simulation.h"
 #include "online_stereo_calibration/tools/estimates_csv.h"
-#include "online_stereo_calibration/tools/pose_interpolation.h"
 #include "online_stereo_calibration/tools/scenario_file.h"
+#include "online_stereo_calibration/tools/tum_trajectory.h"
 
 namespace {
 

@@ -12,9 +12,9 @@
 #include <Eigen/Geometry>
 #include <opencv2/core/mat.hpp>
 
+#include "online_stereo_calibration/core/geometry/pose_interpolation.h"
 #include "online_stereo_calibration/core/sim/stereo_scene_renderer.h"
 #include "online_stereo_calibration/core/sim/vehicle_trajectory.h"
-#include "online_stereo_calibration/tools/pose_interpolation.h"
 #include "online_stereo_calibration/tools/scenario_file.h"
 
 namespace osc {
@@ -31,9 +31,12 @@ struct SimulatedImagePair {
 /// Produces the frames and the odometry of a SimulationScenario. Deterministic.
 class DriveSimulator {
  public:
-  /// @p frames overrides scenario.measurement.frames when > 0.
-  /// @throws std::invalid_argument (bad cameras, a TUM file too short for the frames: the
-  /// message names `frames`) or std::runtime_error (unreadable TUM file).
+  /// @p frames overrides scenario.measurement.frames when > 0. The recorded trajectory is
+  /// scenario.measurement.recorded_trajectory (parseScenarioYaml fills it), else the file of
+  /// scenario.trajectory.
+  /// @throws std::invalid_argument (bad cameras, a TUM file too short for the frames and the
+  /// odometry's time offset: the message names `frames`) or std::runtime_error (unreadable
+  /// TUM file).
   DriveSimulator(const SimulationScenario& scenario, int frames = -1);
   ~DriveSimulator();
 
@@ -46,7 +49,8 @@ class DriveSimulator {
   Vector12d truthAt(int frame) const { return scenario_.measurement.truthParametersAt(frame); }
   /// Initial guess: truth at frame 0 + scenario.initial_error.
   Vector12d initialGuess() const { return scenario_.measurement.initialGuessParameters(); }
-  /// Renders one frame (thread-safe).
+  /// Renders one frame (thread-safe). A blind frame (scenario blind_frames) is rendered at
+  /// kBlindFrameExposureGain times the exposure.
   SimulatedImagePair renderFrame(int frame) const;
 
   /// Noisy odometry T_odom_veh at odom_rate_hz (ROS stamps) from frame 0's stamp to one odom
@@ -57,6 +61,10 @@ class DriveSimulator {
   /// measurement-level simulator assume, while the absolute pose drifts. (Multiplying the true
   /// pose by an accumulated body-frame error instead would rotate every later increment by
   /// that error, ~0.7 deg after 1000 frames: a systematic error that biased x_caml.)
+  /// The scenario's odometry_error applies too: the sample stamped start_stamp + t holds the
+  /// true motion up to drive time t + time_offset (the stamps are shifted by -time_offset
+  /// against the truth), and each true increment gets the scale error and the Gauss-Markov
+  /// biases (OdometryErrorProcess, seeded with the scenario seed) before the white noise.
   std::vector<StampedPose> odometry() const;
 
   const SimulationScenario& scenario() const { return scenario_; }
@@ -68,7 +76,7 @@ class DriveSimulator {
   int frames_;
   CameraModel left_, right_;
   std::unique_ptr<VehicleTrajectory> analytic_;
-  PoseTrajectory recorded_;
+  std::shared_ptr<const PoseTrajectory> recorded_;
   double recorded_start_ = 0.0;
   std::unique_ptr<StereoSceneRenderer> renderer_;
 };

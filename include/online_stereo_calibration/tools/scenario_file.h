@@ -22,15 +22,30 @@
 /// step:              {vehicle_to_left: [6], left_to_right: [6]}
 /// drift_per_second:  {vehicle_to_left: [6], left_to_right: [6]}
 /// motion: {speed, roll_amplitude, pitch_amplitude, roll_period, pitch_period,
-///          yaw_rate_amplitude, yaw_period, heave_amplitude, heave_period, planar}
-/// motion_rotation_noise: 3.49e-4     # rad per axis per 0.1 s (odometry error)
+///          yaw_rate_amplitude, yaw_period, heave_amplitude, heave_period, planar,
+///          stops: [[start, duration], ...],   # s; the vehicle stands still (in order)
+///          stop_ramp: 1.0}                    # s of smooth slow-down / speed-up
+/// motion_rotation_noise: 3.49e-4     # rad per axis per 0.1 s (odometry white noise)
 /// motion_translation_noise: 0.002    # m per axis per 0.1 s
-/// trajectory: {tum_file: path, start_offset: 0}   # optional: replaces `motion`
+/// odometry_error: {time_offset: 0,          # s, odometry clock ahead of the cameras
+///                  scale_error: 0,          # translation x (1 + scale_error)
+///                  rotation_rate_bias: 0,   # rad/s, steady-state std per axis
+///                  velocity_bias: 0,        # m/s, steady-state std per axis
+///                  bias_correlation_time: 30}  # s (Gauss-Markov)
+/// blind_frames: [[first, last], ...]   # frames (both included) with nothing to track
+/// moving_point_fraction: 0             # measurement level only (see below)
+/// moving_point_speed: 2.0              # m/s
+/// trajectory: {tum_file: path, start_offset: 0}   # optional: replaces `motion` (no stops)
 /// rendering: {scene_seed, ground_undulation, structure_density, image_noise, blur_sigma,
 ///             supersampling, odom_rate_hz, start_stamp}
 /// ```
 /// Keys left out keep the preset's value. Relative paths are resolved against the scenario
-/// file's directory first, then the current directory.
+/// file's directory first, then the current directory. The keys map to the
+/// MeasurementScenario fields of the same names (their docs give the ranges; `trajectory`
+/// is read into recorded_trajectory / recorded_start_offset). In `simulate` (the image-level
+/// drive, DriveSimulator) blind frames are rendered almost black and the odometry carries
+/// odometry_error; moving points exist only in measurement-level runs (MeasurementSimulator):
+/// the rendered scene is static.
 #pragma once
 
 #include <cstdint>
@@ -62,6 +77,7 @@ struct TumTrajectoryOption {
 
 /// A parsed scenario file.
 struct SimulationScenario {
+  /// With `trajectory`, measurement.recorded_trajectory holds the TUM file's poses.
   MeasurementScenario measurement;
   SceneRenderingOptions rendering;
   std::optional<TumTrajectoryOption> trajectory;

@@ -12,7 +12,6 @@
 
 #include "online_stereo_calibration/core/frontend/stereo_front_end.h"
 #include "online_stereo_calibration/core/sim/measurement_simulator.h"
-#include "online_stereo_calibration/core/sim/vehicle_trajectory.h"
 
 namespace osc {
 
@@ -100,15 +99,8 @@ std::vector<ImageFrameResult> runImageScenario(
         " must be in [0, 1) (a gain factor 1 +- v must stay positive)");
   }
   MeasurementSimulator simulator(scenario);  // motion noise, truth and poses
-  const VehicleTrajectory& trajectory = simulator.trajectory();
   SceneConfig scene = options.scene;
-  scene.path.clear();
-  const double duration = scenario.frames / scenario.rate_hz;
-  const double speed = std::max(scenario.motion.speed, 0.1);
-  const int samples = std::max(2, static_cast<int>(std::ceil(duration * speed)) + 1);
-  for (int i = 0; i <= samples; ++i) {
-    scene.path.push_back(trajectory.groundPosition(duration * i / samples));
-  }
+  scene.path = simulator.groundTrack();  // analytic (with stops) or recorded
   const StereoSceneRenderer renderer(scene);
   const CameraModel& left_camera = simulator.leftCamera();
   const CameraModel& right_camera = simulator.rightCamera();
@@ -123,6 +115,9 @@ std::vector<ImageFrameResult> runImageScenario(
   std::unordered_map<PointId, Birth> births;
   std::vector<ImageFrameResult> results;
   results.reserve(static_cast<size_t>(scenario.frames));
+  // The pipeline wants the motion since the last pair it processed: a refused pair (e.g. the
+  // dark images of a blind frame) adds its motion to the next pair's.
+  std::optional<MotionIncrement> since_processed;
   SimulatedFrame frame;
   while (simulator.nextFrame(&frame)) {
     ImageFrameResult r;
@@ -134,18 +129,36 @@ std::vector<ImageFrameResult> runImageScenario(
     std::mt19937 exposure_rng(render.noise_seed);
     std::uniform_real_distribution<double> flicker(1.0 - options.exposure_variation,
                                                    1.0 + options.exposure_variation);
-    render.exposure_gain = options.render.exposure_gain * flicker(exposure_rng);
+    // A blind frame is rendered almost black (only the noise remains to see).
+    const double gain =
+        options.render.exposure_gain * (frame.blind ? kBlindFrameExposureGain : 1.0);
+    render.exposure_gain = gain * flicker(exposure_rng);
     const cv::Mat left = renderer.render(left_camera, T_world_lopt, render);
     render.noise_seed += 1u;
-    render.exposure_gain = options.render.exposure_gain * flicker(exposure_rng);
+    render.exposure_gain = gain * flicker(exposure_rng);
     const cv::Mat right = renderer.render(right_camera, T_world_ropt, render);
     r.render_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - render_start)
             .count();
 
-    const PipelineResult result = pipeline.process(left, right, frame.measured_motion);
+    MotionIncrement motion = frame.measured_motion;
+    if (since_processed) {
+      motion.T_prev_curr = since_processed->T_prev_curr * motion.T_prev_curr;
+      motion.dt += since_processed->dt;
+    }
+    const PipelineResult result = pipeline.process(left, right, motion);
     r.processed = result.processed;
     r.front_end = result.front_end;
+    since_processed.reset();
+    if (!result.processed) {
+      // Nothing to check: the front end's lists are still the last processed pair's.
+      if (frame.index > 0) since_processed = motion;
+      r.filter =
+          makeFrameResult(frame, result.estimate, result.estimator, 1e3 * result.processing_time);
+      if (on_frame) on_frame(r, pipeline);
+      results.push_back(r);
+      continue;
+    }
 
     // Correctness against the renderer's ground truth.
     const StereoFrontEnd& front_end = pipeline.frontEnd();

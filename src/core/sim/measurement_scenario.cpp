@@ -1,7 +1,10 @@
 #include "online_stereo_calibration/core/sim/measurement_scenario.h"
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
+
+#include "online_stereo_calibration/core/geometry/pose_interpolation.h"
 
 namespace osc {
 
@@ -55,6 +58,61 @@ void validateMotion(const VehicleMotionProfile& m, Problems* p) {
   positive(m.pitch_period, "motion.pitch_period");
   positive(m.yaw_period, "motion.yaw_period");
   positive(m.heave_period, "motion.heave_period");
+  nonNegative(m.stop_ramp, "motion.stop_ramp");
+}
+
+/// Stops: each inside the drive [0, drive_end], in order, the gaps leaving room for the ramps.
+void validateStops(const VehicleMotionProfile& m, double drive_end, Problems* p) {
+  const double ramp = std::isfinite(m.stop_ramp) && m.stop_ramp >= 0.0 ? m.stop_ramp : 0.0;
+  for (std::size_t i = 0; i < m.stops.size(); ++i) {
+    const TimeSpan& stop = m.stops[i];
+    const std::string field = "motion.stops[" + std::to_string(i) + "]";
+    p->require(stop.start >= 0.0 && std::isfinite(stop.start), field + ".start",
+               ">= 0 s and finite", stop.start);
+    p->require(stop.duration > 0.0 && std::isfinite(stop.duration), field + ".duration",
+               "> 0 s and finite", stop.duration);
+    const double end = stop.start + stop.duration;
+    std::ostringstream drive;
+    drive << "<= the last frame's time " << drive_end << " s (start + duration)";
+    p->require(end <= drive_end, field, drive.str(), end);
+    if (i > 0) {
+      const TimeSpan& before = m.stops[i - 1];
+      const double gap = stop.start - (before.start + before.duration);
+      p->require(gap >= 2.0 * ramp, field,
+                 "after motion.stops[" + std::to_string(i - 1) +
+                     "] with a gap >= 2 * motion.stop_ramp (in order, ramps not overlapping); "
+                     "gap in s",
+                 gap);
+    }
+  }
+}
+
+void validateOdometryError(const OdometryErrorModel& e, Problems* p) {
+  p->require(std::abs(e.time_offset) <= 0.5, "odometry_error.time_offset", "in [-0.5, 0.5] s",
+             e.time_offset);
+  p->require(std::abs(e.scale_error) <= 0.2, "odometry_error.scale_error", "in [-0.2, 0.2]",
+             e.scale_error);
+  p->require(e.rotation_rate_bias >= 0.0 && std::isfinite(e.rotation_rate_bias),
+             "odometry_error.rotation_rate_bias", ">= 0 rad/s and finite", e.rotation_rate_bias);
+  p->require(e.velocity_bias >= 0.0 && std::isfinite(e.velocity_bias),
+             "odometry_error.velocity_bias", ">= 0 m/s and finite", e.velocity_bias);
+  p->require(e.bias_correlation_time > 0.0 && std::isfinite(e.bias_correlation_time),
+             "odometry_error.bias_correlation_time", "> 0 s and finite", e.bias_correlation_time);
+}
+
+void validateBlindFrames(const std::vector<FrameSpan>& spans, int frames, Problems* p) {
+  for (std::size_t i = 0; i < spans.size(); ++i) {
+    const FrameSpan& span = spans[i];
+    const std::string field = "blind_frames[" + std::to_string(i) + "]";
+    p->require(span.first >= 0, field + ".first", ">= 0", span.first);
+    p->require(span.last >= span.first, field + ".last", ">= first", span.last);
+    p->require(span.last < frames, field + ".last", "< frames (inside the drive)", span.last);
+    if (i > 0) {
+      p->require(span.first > spans[i - 1].last, field + ".first",
+                 "> blind_frames[" + std::to_string(i - 1) + "].last (in order, not overlapping)",
+                 span.first);
+    }
+  }
 }
 
 void validateCamera(const CameraIntrinsics& intrinsics, const std::string& field, Problems* p) {
@@ -103,7 +161,51 @@ std::vector<std::string> MeasurementScenario::validate() const {
             mean_track_length);
   p.require(outlier_fraction >= 0.0 && outlier_fraction <= 1.0, "outlier_fraction", "in [0, 1]",
             outlier_fraction);
+  validateOdometryError(odometry_error, &p);
+  validateBlindFrames(blind_frames, frames, &p);
+  p.require(moving_point_fraction >= 0.0 && moving_point_fraction <= 1.0, "moving_point_fraction",
+            "in [0, 1]", moving_point_fraction);
+  p.require(moving_point_speed >= 0.0 && std::isfinite(moving_point_speed), "moving_point_speed",
+            ">= 0 m/s and finite", moving_point_speed);
+  p.require(recorded_start_offset >= 0.0 && std::isfinite(recorded_start_offset),
+            "recorded_start_offset", ">= 0 s and finite", recorded_start_offset);
+  const double last_frame_time = frames > 0 && rate_hz > 0.0 ? (frames - 1) / rate_hz : 0.0;
+  if (!recorded_trajectory) {
+    validateStops(motion, last_frame_time, &p);
+  } else {
+    if (!motion.stops.empty()) {
+      p.add("motion.stops must be empty with a recorded_trajectory (it replaces the motion)");
+    }
+    if (recorded_trajectory->size() < 2) {
+      p.add("recorded_trajectory must hold at least 2 poses");
+    } else if (std::isfinite(recorded_start_offset) && recorded_start_offset >= 0.0) {
+      // Every frame's pose and every measured increment's shifted interval must be recorded.
+      const double offset =
+          std::isfinite(odometry_error.time_offset) ? odometry_error.time_offset : 0.0;
+      const double span = recorded_trajectory->lastStamp() - recorded_trajectory->firstStamp();
+      const double first_needed = recorded_start_offset + std::min(0.0, offset);
+      const double last_needed = recorded_start_offset + last_frame_time + std::max(0.0, offset);
+      p.require(first_needed >= 0.0, "recorded_start_offset",
+                ">= -odometry_error.time_offset (the shifted first frame must be recorded); "
+                "recorded_start_offset + time_offset in s",
+                first_needed);
+      if (last_needed > span + 1e-9) {
+        std::ostringstream message;
+        message << "frames / recorded_start_offset: " << frames << " frames at " << rate_hz
+                << " Hz from recorded_start_offset " << recorded_start_offset
+                << " s (odometry_error.time_offset " << offset << " s) need the recording up to "
+                << last_needed << " s after its first stamp, but it spans only " << span << " s";
+        p.add(message.str());
+      }
+    }
+  }
   return p.take();
+}
+
+bool MeasurementScenario::isBlindFrame(int frame) const {
+  return std::any_of(blind_frames.begin(), blind_frames.end(), [frame](const FrameSpan& span) {
+    return frame >= span.first && frame <= span.last;
+  });
 }
 
 Vector12d MeasurementScenario::truthParametersAt(int frame) const {

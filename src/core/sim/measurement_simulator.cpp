@@ -22,6 +22,10 @@ constexpr double kOutlierMinPx = 10.0, kOutlierMaxPx = 50.0;
 /// Births give up after this many rejected samples per allowed birth (e.g. cameras whose
 /// fields of view barely overlap), so a frame never loops for long.
 constexpr int kBirthAttemptsPerPoint = 20;
+/// Slack (s) at the ends of a recorded trajectory for rounding of the frame times.
+constexpr double kRecordedTolerance = 1e-9;
+/// Random stream numbers (with the scenario's seed).
+constexpr unsigned kTrackStream = 1, kPixelStream = 2, kMotionStream = 3, kMovingStream = 5;
 
 MeasurementScenario validated(const MeasurementScenario& scenario) {
   const std::vector<std::string> problems = scenario.validate();
@@ -41,11 +45,54 @@ MeasurementSimulator::RandomStream::RandomStream(unsigned seed, unsigned stream)
 MeasurementSimulator::MeasurementSimulator(const MeasurementScenario& scenario)
     : scenario_(validated(scenario)),
       trajectory_(scenario_.motion),
+      recorded_(scenario_.recorded_trajectory),
       left_(scenario_.left),
       right_(scenario_.right),
-      track_rng_(scenario_.seed, 1),
-      pixel_rng_(scenario_.seed, 2),
-      motion_rng_(scenario_.seed, 3) {}
+      track_rng_(scenario_.seed, kTrackStream),
+      pixel_rng_(scenario_.seed, kPixelStream),
+      motion_rng_(scenario_.seed, kMotionStream),
+      moving_rng_(scenario_.seed, kMovingStream),
+      odometry_error_(scenario_.odometry_error, scenario_.seed) {
+  if (recorded_) recorded_start_ = recorded_->firstStamp() + scenario_.recorded_start_offset;
+}
+
+Eigen::Isometry3d MeasurementSimulator::truePose(double t) const {
+  if (!recorded_) return trajectory_.pose(t);
+  const std::optional<Eigen::Isometry3d> pose =
+      recorded_->at(recorded_start_ + t, kRecordedTolerance);
+  if (!pose) {
+    throw std::out_of_range("MeasurementSimulator::truePose: t = " + std::to_string(t) +
+                            " s lies outside the recorded trajectory");
+  }
+  return *pose;
+}
+
+Eigen::Isometry3d MeasurementSimulator::trueMotion(double t0, double t1) const {
+  if (!recorded_) return trajectory_.motionBetween(t0, t1);
+  return truePose(t0).inverse() * truePose(t1);
+}
+
+std::vector<Eigen::Vector2d> MeasurementSimulator::groundTrack() const {
+  const double duration = scenario_.frames / scenario_.rate_hz;
+  std::vector<Eigen::Vector2d> track;
+  if (!recorded_) {
+    // Evenly in time, one sample per metre at the profile speed (never faster: stops only
+    // slow it down).
+    const double speed = std::max(scenario_.motion.speed, 0.1);
+    const int samples = std::max(2, static_cast<int>(std::ceil(duration * speed)) + 1);
+    for (int i = 0; i <= samples; ++i) {
+      track.push_back(trajectory_.groundPosition(duration * i / samples));
+    }
+    return track;
+  }
+  const double end = std::min(recorded_start_ + duration, recorded_->lastStamp());
+  track.push_back(truePose(0.0).translation().head<2>());
+  for (const StampedPose& p : recorded_->poses()) {
+    if (p.stamp > recorded_start_ && p.stamp < end) track.push_back(p.pose.translation().head<2>());
+  }
+  track.push_back(recorded_->at(end, kRecordedTolerance)->translation().head<2>());
+  return track;
+}
 
 StereoExtrinsics MeasurementSimulator::initialGuess() const {
   return StereoExtrinsics::fromParameters(scenario_.initialGuessParameters());
@@ -57,7 +104,12 @@ StereoExtrinsics MeasurementSimulator::truthAt(int frame) const {
 
 std::optional<Eigen::Vector3d> MeasurementSimulator::worldPoint(PointId id) const {
   if (id == 0 || id > born_points_.size()) return std::nullopt;
-  return born_points_[id - 1];
+  return born_points_[id - 1].position;
+}
+
+std::optional<Eigen::Vector3d> MeasurementSimulator::worldPointAt(PointId id, double t) const {
+  if (id == 0 || id > born_points_.size()) return std::nullopt;
+  return born_points_[id - 1].at(t);
 }
 
 void MeasurementSimulator::dropTracks(const std::vector<PointId>& ids) {
@@ -74,14 +126,25 @@ bool MeasurementSimulator::nextFrame(SimulatedFrame* frame) {
   out.index = next_frame_++;
   const double dt = 1.0 / scenario_.rate_hz;
   out.stamp = out.index * dt;
-  out.T_world_veh = trajectory_.pose(out.stamp);
+  out.T_world_veh = truePose(out.stamp);
   out.truth = truthAt(out.index);
   out.true_motion.dt = out.measured_motion.dt = dt;
   if (out.index > 0) {
-    out.true_motion.T_prev_curr = previous_pose_.inverse() * out.T_world_veh;
-    out.measured_motion = perturbMotion(out.true_motion);
+    const double previous = (out.index - 1) * dt;
+    out.true_motion.T_prev_curr = trueMotion(previous, out.stamp);
+    // The odometry's clock runs time_offset ahead of the cameras'.
+    MotionIncrement reported = out.true_motion;
+    const double offset = scenario_.odometry_error.time_offset;
+    if (offset != 0.0) reported.T_prev_curr = trueMotion(previous + offset, out.stamp + offset);
+    out.measured_motion = perturbMotion(odometry_error_.apply(reported));
   }
-  previous_pose_ = out.T_world_veh;
+  if (scenario_.isBlindFrame(out.index)) {
+    // Nothing can be tracked: every track is lost, none is born (no random draws either).
+    out.blind = true;
+    live_.clear();
+    *frame = std::move(out);
+    return true;
+  }
 
   StereoView view;
   view.T_lopt_world = (out.T_world_veh * out.truth.vehicleToLeftOptical()).inverse();
@@ -171,12 +234,22 @@ void MeasurementSimulator::advanceTracks(const StereoView& view, SimulatedFrame*
     // Drawn for every track, so the loss of one track does not shift the others' draws.
     const bool lost = track_rng_.uniform(0.0, 1.0) < loss_probability;
     if (lost) continue;
-    const std::optional<StereoPixels> pixels = projectBoth(track.point_world, view);
+    const std::optional<StereoPixels> pixels = projectBoth(track.point.at(frame->stamp), view);
     if (!pixels) continue;
     frame->observations.push_back(observe(track.id, *pixels, frame));
+    if (track.point.moving) frame->moving_ids.push_back(track.id);
     survivors.push_back(track);
   }
   live_.swap(survivors);
+}
+
+std::optional<Eigen::Vector3d> MeasurementSimulator::drawMovingVelocity() {
+  // Drawn only when enabled, so a scenario without moving points is unchanged.
+  if (!(scenario_.moving_point_fraction > 0.0)) return std::nullopt;
+  if (!(moving_rng_.uniform(0.0, 1.0) < scenario_.moving_point_fraction)) return std::nullopt;
+  const double heading = moving_rng_.uniform(0.0, 2.0 * M_PI);
+  return Eigen::Vector3d(scenario_.moving_point_speed * std::cos(heading),
+                         scenario_.moving_point_speed * std::sin(heading), 0.0);
 }
 
 void MeasurementSimulator::birthTracks(const StereoView& view, SimulatedFrame* frame) {
@@ -200,11 +273,17 @@ void MeasurementSimulator::birthTracks(const StereoView& view, SimulatedFrame* f
     const Eigen::Vector3d point_world = T_world_lopt * in_left;
     const std::optional<StereoPixels> pixels = projectBoth(point_world, view);
     if (!pixels) continue;
-    born_points_.push_back(point_world);
+    BornPoint born{point_world, frame->stamp, Eigen::Vector3d::Zero(), false};
+    if (const std::optional<Eigen::Vector3d> velocity = drawMovingVelocity()) {
+      born.velocity = *velocity;
+      born.moving = true;
+    }
+    born_points_.push_back(born);
     const PointId id = born_points_.size();
-    live_.push_back(Track{id, point_world});
+    live_.push_back(Track{id, born});
     frame->observations.push_back(observe(id, *pixels, frame));
     frame->new_point_ids.push_back(id);
+    if (born.moving) frame->moving_ids.push_back(id);
     ++births;
   }
 }

@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+
 #include <stdexcept>
+#include "online_stereo_calibration/core/sim/odometry_error.h"
+#include "online_stereo_calibration/tools/tum_trajectory.h"
 
 namespace osc {
 namespace {
@@ -23,17 +26,28 @@ DriveSimulator::DriveSimulator(const SimulationScenario& scenario, int frames)
       left_(scenario.measurement.left),
       right_(scenario.measurement.right) {
   scenario_.measurement.frames = frames_;
-  const double duration =
-      (frames_ - 1) / scenario_.measurement.rate_hz + 2.0 / scenario_.rendering.odom_rate_hz;
-  if (scenario_.trajectory) {
-    recorded_ = readTumTrajectory(scenario_.trajectory->file);
-    recorded_start_ = recorded_.firstStamp() + scenario_.trajectory->start_offset;
-    if (recorded_start_ + duration > recorded_.lastStamp()) {
-      throw std::invalid_argument(
-          "frames: " + std::to_string(frames_) + " frames at " +
-          std::to_string(scenario_.measurement.rate_hz) + " Hz need " + std::to_string(duration) +
-          " s but trajectory.tum_file covers only " +
-          std::to_string(recorded_.lastStamp() - recorded_start_) + " s after start_offset");
+  const double time_offset = scenario_.measurement.odometry_error.time_offset;
+  const double duration = (frames_ - 1) / scenario_.measurement.rate_hz +
+                          2.0 / scenario_.rendering.odom_rate_hz + std::max(0.0, time_offset);
+  recorded_ = scenario_.measurement.recorded_trajectory;
+  double start_offset = scenario_.measurement.recorded_start_offset;
+  if (!recorded_ && scenario_.trajectory) {
+    recorded_ =
+        std::make_shared<const PoseTrajectory>(readTumTrajectory(scenario_.trajectory->file));
+    start_offset = scenario_.trajectory->start_offset;
+  }
+  if (recorded_) {
+    if (recorded_->size() < 2) throw std::invalid_argument("trajectory: fewer than 2 poses");
+    recorded_start_ = recorded_->firstStamp() + start_offset;
+    if (recorded_start_ + duration > recorded_->lastStamp() ||
+        recorded_start_ + std::min(0.0, time_offset) < recorded_->firstStamp()) {
+      throw std::invalid_argument("frames: " + std::to_string(frames_) + " frames at " +
+                                  std::to_string(scenario_.measurement.rate_hz) + " Hz need " +
+                                  std::to_string(duration) + " s (odometry_error.time_offset " +
+                                  std::to_string(time_offset) +
+                                  " s included) but trajectory.tum_file covers only " +
+                                  std::to_string(recorded_->lastStamp() - recorded_start_) +
+                                  " s after start_offset " + std::to_string(start_offset) + " s");
     }
   } else {
     analytic_ = std::make_unique<VehicleTrajectory>(scenario_.measurement.motion);
@@ -49,7 +63,7 @@ DriveSimulator::DriveSimulator(const SimulationScenario& scenario, int frames)
   double scene_duration = (scenario_frames - 1) / scenario_.measurement.rate_hz +
                           2.0 / scenario_.rendering.odom_rate_hz;
   if (scenario_.trajectory) {
-    scene_duration = std::min(scene_duration, recorded_.lastStamp() - recorded_start_);
+    scene_duration = std::min(scene_duration, recorded_->lastStamp() - recorded_start_);
   }
   Eigen::Vector2d last = truePose(0.0).translation().head<2>();
   scene.path.push_back(last);
@@ -71,7 +85,7 @@ double DriveSimulator::frameStamp(int frame) const {
 
 Eigen::Isometry3d DriveSimulator::truePose(double t) const {
   if (analytic_) return analytic_->pose(t);
-  const auto pose = recorded_.at(recorded_start_ + t, 1e-9);
+  const auto pose = recorded_->at(recorded_start_ + t, 1e-9);
   if (!pose) throw std::out_of_range("DriveSimulator: time outside the recorded trajectory");
   return *pose;
 }
@@ -90,6 +104,7 @@ SimulatedImagePair DriveSimulator::renderFrame(int frame) const {
   options.blur_sigma = scenario_.rendering.blur_sigma;
   options.supersampling = scenario_.rendering.supersampling;
   options.noise_seed = 2u * static_cast<unsigned>(frame) + 1u;
+  if (scenario_.measurement.isBlindFrame(frame)) options.exposure_gain = kBlindFrameExposureGain;
   out.left = renderer_->render(left_, T_world_lopt, options);
   options.noise_seed += 1u;
   out.right = renderer_->render(right_, T_world_ropt, options);
@@ -103,11 +118,16 @@ std::vector<StampedPose> DriveSimulator::odometry() const {
   const double scale = std::sqrt(period / kNoiseReferenceStep);
   std::mt19937_64 engine(0x5eedULL * (scenario_.measurement.seed + 1ULL) + 17ULL);
   std::normal_distribution<double> normal(0.0, 1.0);
+  OdometryErrorProcess errors(scenario_.measurement.odometry_error, scenario_.measurement.seed);
+  // The odometry's clock runs time_offset ahead: the sample stamped start_stamp + k * period
+  // holds the true motion up to drive time k * period + time_offset.
+  const double offset = scenario_.measurement.odometry_error.time_offset;
   std::vector<StampedPose> out;
   out.reserve(samples);
-  Eigen::Isometry3d pose = truePose(0.0), previous_true = pose;
+  Eigen::Isometry3d pose = truePose(offset);
+  double previous_t = offset;
   for (int k = 0; k < samples; ++k) {
-    const double t = k * period;
+    const double t = k * period + offset;
     if (k > 0) {
       Vector6d delta;
       for (int i = 0; i < 3; ++i) {
@@ -116,11 +136,15 @@ std::vector<StampedPose> DriveSimulator::odometry() const {
       for (int i = 3; i < 6; ++i) {
         delta(i) = scale * scenario_.measurement.motion_rotation_noise * normal(engine);
       }
-      const Eigen::Isometry3d current_true = truePose(t);
-      pose = pose * boxPlus(previous_true.inverse() * current_true, delta);
-      previous_true = current_true;
+      MotionIncrement increment;
+      increment.dt = t - previous_t;
+      // Exactly the identity while standing in a stop.
+      increment.T_prev_curr = analytic_ ? analytic_->motionBetween(previous_t, t)
+                                        : truePose(previous_t).inverse() * truePose(t);
+      pose = pose * boxPlus(errors.apply(increment).T_prev_curr, delta);
+      previous_t = t;
     }
-    out.push_back({scenario_.rendering.start_stamp + t, pose});
+    out.push_back({scenario_.rendering.start_stamp + k * period, pose});
   }
   return out;
 }

@@ -12,10 +12,14 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "online_stereo_calibration/tools/tum_trajectory.h"
+
 namespace osc {
 namespace {
 
 /// Version of the simulator's output; part of the cache fingerprint.
+// Not bumped for stops, odometry errors and blind frames: they are keys of the scenario text
+// (part of the fingerprint), and a drive without them is bit-identical to before.
 constexpr const char* kSimulatorVersion =
     "simulate-3";  // 2: scene along the whole drive, 3: dead-reckoned odometry
 
@@ -210,6 +214,71 @@ void readTruth(const YAML::Node& node, const std::string& base, Vector12d* truth
   readParameters(node, "truth", truth, p);
 }
 
+/// A list of [a, b] pairs, e.g. [[10, 5], [40, 3]]; false (and a problem) if malformed.
+bool readPairs(const YAML::Node& node, const std::string& key,
+               std::vector<std::pair<YAML::Node, YAML::Node>>* out, Problems* p) {
+  if (!node.IsSequence()) {
+    p->add(key, "must be a list of [a, b] pairs");
+    return false;
+  }
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    if (!node[i].IsSequence() || node[i].size() != 2) {
+      p->add(key + "[" + std::to_string(i) + "]", "must be a pair [a, b]");
+      return false;
+    }
+    out->emplace_back(node[i][0], node[i][1]);
+  }
+  return true;
+}
+
+void readStops(const YAML::Node& node, std::vector<TimeSpan>* stops, Problems* p) {
+  std::vector<std::pair<YAML::Node, YAML::Node>> pairs;
+  if (!readPairs(node, "motion.stops", &pairs, p)) return;
+  stops->clear();
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const std::string key = "motion.stops[" + std::to_string(i) + "]";
+    TimeSpan stop;
+    readDouble(pairs[i].first, key + ".start", &stop.start, p);
+    readDouble(pairs[i].second, key + ".duration", &stop.duration, p);
+    stops->push_back(stop);
+  }
+}
+
+void readBlindFrames(const YAML::Node& node, std::vector<FrameSpan>* spans, Problems* p) {
+  std::vector<std::pair<YAML::Node, YAML::Node>> pairs;
+  if (!readPairs(node, "blind_frames", &pairs, p)) return;
+  spans->clear();
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const std::string key = "blind_frames[" + std::to_string(i) + "]";
+    FrameSpan span;
+    readInt(pairs[i].first, key + ".first", &span.first, p);
+    readInt(pairs[i].second, key + ".last", &span.last, p);
+    spans->push_back(span);
+  }
+}
+
+void readOdometryError(const YAML::Node& node, OdometryErrorModel* e, Problems* p) {
+  if (!node.IsMap()) {
+    p->add("odometry_error", "must be a map");
+    return;
+  }
+  checkKeys(node, "odometry_error.",
+            {"time_offset", "scale_error", "rotation_rate_bias", "velocity_bias",
+             "bias_correlation_time"},
+            p);
+  const std::pair<const char*, double*> fields[] = {
+      {"time_offset", &e->time_offset},
+      {"scale_error", &e->scale_error},
+      {"rotation_rate_bias", &e->rotation_rate_bias},
+      {"velocity_bias", &e->velocity_bias},
+      {"bias_correlation_time", &e->bias_correlation_time}};
+  for (const auto& f : fields) {
+    if (node[f.first]) {
+      readDouble(node[f.first], std::string("odometry_error.") + f.first, f.second, p);
+    }
+  }
+}
+
 void readMotion(const YAML::Node& node, VehicleMotionProfile* m, Problems* p) {
   if (!node.IsMap()) {
     p->add("motion", "must be a map");
@@ -217,7 +286,8 @@ void readMotion(const YAML::Node& node, VehicleMotionProfile* m, Problems* p) {
   }
   checkKeys(node, "motion.",
             {"speed", "roll_amplitude", "pitch_amplitude", "roll_period", "pitch_period",
-             "yaw_rate_amplitude", "yaw_period", "heave_amplitude", "heave_period", "planar"},
+             "yaw_rate_amplitude", "yaw_period", "heave_amplitude", "heave_period", "planar",
+             "stops", "stop_ramp"},
             p);
   const std::pair<const char*, double*> fields[] = {{"speed", &m->speed},
                                                     {"roll_amplitude", &m->roll_amplitude},
@@ -227,7 +297,8 @@ void readMotion(const YAML::Node& node, VehicleMotionProfile* m, Problems* p) {
                                                     {"yaw_rate_amplitude", &m->yaw_rate_amplitude},
                                                     {"yaw_period", &m->yaw_period},
                                                     {"heave_amplitude", &m->heave_amplitude},
-                                                    {"heave_period", &m->heave_period}};
+                                                    {"heave_period", &m->heave_period},
+                                                    {"stop_ramp", &m->stop_ramp}};
   for (const auto& f : fields) {
     if (node[f.first]) readDouble(node[f.first], std::string("motion.") + f.first, f.second, p);
   }
@@ -238,6 +309,7 @@ void readMotion(const YAML::Node& node, VehicleMotionProfile* m, Problems* p) {
       p->add("motion.planar", "not a boolean");
     }
   }
+  if (node["stops"]) readStops(node["stops"], &m->stops, p);
 }
 
 void readRendering(const YAML::Node& node, SceneRenderingOptions* r, Problems* p) {
@@ -342,9 +414,27 @@ SimulationScenario parseScenarioYaml(const std::string& text, const std::string&
   if (!root.IsMap()) throw std::runtime_error(source_name + ": must be a YAML map");
   Problems p;
   checkKeys(root, "",
-            {"base", "name", "frames", "rate_hz", "seed", "left_camera", "right_camera", "truth",
-             "initial_error", "step_frame", "step", "drift_per_second", "motion",
-             "motion_rotation_noise", "motion_translation_noise", "trajectory", "rendering"},
+            {"base",
+             "name",
+             "frames",
+             "rate_hz",
+             "seed",
+             "left_camera",
+             "right_camera",
+             "truth",
+             "initial_error",
+             "step_frame",
+             "step",
+             "drift_per_second",
+             "motion",
+             "motion_rotation_noise",
+             "motion_translation_noise",
+             "odometry_error",
+             "blind_frames",
+             "moving_point_fraction",
+             "moving_point_speed",
+             "trajectory",
+             "rendering"},
             &p);
   SimulationScenario s;
   s.source_text = text;
@@ -378,10 +468,36 @@ SimulationScenario parseScenarioYaml(const std::string& text, const std::string&
     readDouble(root["motion_translation_noise"], "motion_translation_noise",
                &m.motion_translation_noise, &p);
   }
+  if (root["odometry_error"]) readOdometryError(root["odometry_error"], &m.odometry_error, &p);
+  if (root["blind_frames"]) readBlindFrames(root["blind_frames"], &m.blind_frames, &p);
+  if (root["moving_point_fraction"]) {
+    readDouble(root["moving_point_fraction"], "moving_point_fraction", &m.moving_point_fraction,
+               &p);
+  }
+  if (root["moving_point_speed"]) {
+    readDouble(root["moving_point_speed"], "moving_point_speed", &m.moving_point_speed, &p);
+  }
   if (root["trajectory"]) readTrajectory(root["trajectory"], base_directory, &s.trajectory, &p);
+  if (s.trajectory && p.list.empty()) {
+    // The recording replaces the analytic motion for both simulators (validate() checks
+    // that it covers the frames).
+    try {
+      m.recorded_trajectory =
+          std::make_shared<const PoseTrajectory>(readTumTrajectory(s.trajectory->file));
+      m.recorded_start_offset = s.trajectory->start_offset;
+    } catch (const std::exception& e) {
+      p.add("trajectory.tum_file", e.what());
+    }
+  }
   if (root["rendering"]) readRendering(root["rendering"], &s.rendering, &p);
   if (p.list.empty()) {
-    for (const std::string& problem : m.validate()) p.list.push_back(problem);
+    for (std::string problem : m.validate()) {
+      // The file's name of the field.
+      if (problem.find("recorded_start_offset") != std::string::npos) {
+        problem += " (recorded_start_offset = trajectory.start_offset in the file)";
+      }
+      p.list.push_back(problem);
+    }
   }
   if (!p.list.empty()) {
     std::string message = source_name + ":";

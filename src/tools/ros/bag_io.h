@@ -22,8 +22,8 @@
 #include "online_stereo_calibration/StereoCalibration.h"
 #include "online_stereo_calibration/core/geometry/camera_model.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
+#include "online_stereo_calibration/core/geometry/pose_interpolation.h"
 #include "online_stereo_calibration/ros/conversions.h"
-#include "online_stereo_calibration/tools/pose_interpolation.h"
 
 namespace osc::bag {
 

@@ -96,8 +96,14 @@ std::vector<Eigen::Vector3d> scenePointsOfStereoMatch(
 /// Runs the scenario (scenario.frames pairs, truth incl. its step and drift) through a
 /// CalibrationPipeline started from the scenario's initial guess. The measured motion, the
 /// truth and the vehicle poses come from a MeasurementSimulator of the same scenario (its
-/// motion noise stream), so both runners see identical motion errors. on_frame is called
-/// after each frame if given.
+/// motion noise stream and odometry errors; stops or a recorded trajectory; the scene is
+/// laid along MeasurementSimulator::groundTrack()), so both runners see identical motion
+/// errors. A pair the pipeline refuses (processed = false, e.g. too dark) is not checked
+/// (its counts stay 0) and its motion is added to the next pair's, as the pipeline expects
+/// the motion since the last processed pair. Blind frames are rendered at
+/// kBlindFrameExposureGain times the exposure (the pipeline refuses them as too dark). Moving
+/// points (moving_point_fraction) exist at measurement level only: the rendered scene is
+/// static. on_frame is called after each frame if given.
 /// @throws std::invalid_argument for an invalid scenario, config or exposure_variation.
 std::vector<ImageFrameResult> runImageScenario(
     const MeasurementScenario& scenario, const FilterConfig& filter_config,

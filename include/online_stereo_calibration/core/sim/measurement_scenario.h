@@ -52,10 +52,15 @@ struct VehicleMotionProfile {
   bool planar = false;
   /// Stops (traffic lights, queues): over each span the vehicle stands still. It slows down
   /// over stop_ramp seconds before the span and speeds up over stop_ramp after it; the whole
-  /// profile (steering, roll, pitch, heave) is frozen with it, as if its clock stood still.
-  /// Spans must not overlap (ramps included).
+  /// profile (steering, roll, pitch, heave) is frozen with it, as if its clock stood still
+  /// (a time warp, see VehicleTrajectory: after a stop the profile lags the drive clock by
+  /// duration + stop_ramp). Spans must be in order, start >= 0, end by the last frame's time
+  /// and not overlap (ramps included: the gap between two spans >= 2 stop_ramp). A ramp may
+  /// reach before t = 0 (a stop at start 0 means standing at frame 0). Not allowed with a
+  /// recorded_trajectory (which replaces the whole profile).
   std::vector<TimeSpan> stops;
-  /// Length (s) of the smooth slow-down and speed-up around a stop, >= 0.
+  /// Length (s) of the smooth slow-down and speed-up around a stop, >= 0 (0: an abrupt stop,
+  /// the speed jumps).
   double stop_ramp = 1.0;
 };
 
@@ -65,13 +70,16 @@ struct VehicleMotionProfile {
 struct OdometryErrorModel {
   /// Clock offset (s) of the odometry against the cameras: the motion reported between two
   /// image pairs stamped t0 and t1 is the true motion between t0 + time_offset and
-  /// t1 + time_offset. |time_offset| <= 0.5.
+  /// t1 + time_offset (positive: the odometry runs ahead). |time_offset| <= 0.5. The analytic
+  /// profile is defined at negative times too; with a recorded_trajectory the shifted
+  /// interval of every frame must lie inside the recording (validate() checks it).
   double time_offset = 0.0;
   /// Scale error of the measured translation: each increment's translation is multiplied by
   /// (1 + scale_error). |scale_error| <= 0.2.
   double scale_error = 0.0;
   /// Steady-state std of a slowly varying bias of the measured angular rate (rad/s, per
-  /// axis); the bias times dt is added to each increment's rotation. >= 0.
+  /// axis of the vehicle frame); the bias times dt is added to each increment's rotation
+  /// (R * Exp(b dt), boxPlus convention). >= 0. The arithmetic: OdometryErrorProcess.
   double rotation_rate_bias = 0.0;
   /// Steady-state std of a slowly varying bias of the measured velocity (m/s, per axis, in
   /// the vehicle frame); the bias times dt is added to each increment's translation. >= 0.
@@ -136,21 +144,34 @@ struct MeasurementScenario {
   /// Errors of the measured motion beyond white noise (time offset, scale, biases).
   OdometryErrorModel odometry_error;
   /// Frames in which nothing can be tracked (a texture-poor view: sky, a uniform wall,
-  /// darkness): no observation, every track is lost. Spans must be in order and not overlap.
+  /// darkness): no observation, every track is lost, no track is born (the next frame
+  /// starts new tracks with new ids). The motion is reported as usual. Spans must be in
+  /// order, not overlap and lie within [0, frames - 1]. At image level these frames are
+  /// rendered almost black (kBlindFrameExposureGain) so that the front end finds nothing.
   std::vector<FrameSpan> blind_frames;
   /// Fraction of the born points that lie on moving objects, in [0, 1]: each such point
-  /// moves at a constant velocity of moving_point_speed (m/s) in a random horizontal direction.
+  /// moves at a constant velocity of moving_point_speed (m/s) in a random horizontal (world
+  /// x-y) direction from its birth on, and its observations follow it
+  /// (SimulatedFrame::moving_ids). The decisions come from their own random stream (5), so a
+  /// fraction of 0 leaves the frames unchanged. Measurement level only: the image-level
+  /// runners do not render moving objects.
   double moving_point_fraction = 0.0;
   /// Speed (m/s) of the points on moving objects, >= 0.
   double moving_point_speed = 2.0;
-  /// A recorded trajectory (T_world_veh over time, e.g. a TUM file) that replaces `motion`
-  /// when set: frame k is taken at recorded_start_offset + k / rate_hz after its first stamp.
+  /// A recorded trajectory (T_world_veh over time, e.g. a TUM file read with
+  /// tools/tum_trajectory.h) that replaces `motion` when set: frame k is taken at
+  /// recorded_start_offset + k / rate_hz after its first stamp, interpolated linearly +
+  /// SLERP (PoseTrajectory::at). It must hold >= 2 poses and cover every frame, shifted
+  /// by odometry_error.time_offset too (validate() names frames / recorded_start_offset).
   std::shared_ptr<const PoseTrajectory> recorded_trajectory;
   /// s after the recorded trajectory's first stamp at which frame 0 is taken, >= 0.
   double recorded_start_offset = 0.0;
 
   /// Every problem, each naming the field and the allowed range; empty if valid.
   std::vector<std::string> validate() const;
+
+  /// True if @p frame lies in one of blind_frames.
+  bool isBlindFrame(int frame) const;
 
   /// True parameters at a frame: truth + drift_per_second * t + step (from step_frame on).
   Vector12d truthParametersAt(int frame) const;

@@ -1,10 +1,12 @@
 /// @file measurement_simulator.h
-/// @brief Measurement-level simulator of the seed's experiment: static 3D points around a
-/// vehicle trajectory, a true (possibly changing) calibration, noisy motion increments and
-/// noisy stereo pixel measurements with the births and deaths of a real feature tracker.
+/// @brief Measurement-level simulator of the seed's experiment: 3D points (static, or on moving
+/// objects) around a vehicle trajectory (analytic with stops, or recorded), a true (possibly
+/// changing) calibration, noisy and biased motion increments and noisy stereo pixel
+/// measurements with the births and deaths of a real feature tracker (and blind frames).
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <random>
 #include <vector>
@@ -15,7 +17,9 @@
 #include "online_stereo_calibration/core/estimator/types.h"
 #include "online_stereo_calibration/core/geometry/camera_model.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
+#include "online_stereo_calibration/core/geometry/pose_interpolation.h"
 #include "online_stereo_calibration/core/sim/measurement_scenario.h"
+#include "online_stereo_calibration/core/sim/odometry_error.h"
 #include "online_stereo_calibration/core/sim/vehicle_trajectory.h"
 
 namespace osc {
@@ -27,7 +31,9 @@ struct SimulatedFrame {
   int index = 0;
   /// Time of the frame (s): index / rate_hz.
   double stamp = 0.0;
-  /// Noisy motion since the previous frame; frame 0: identity with dt = 1 / rate_hz.
+  /// Measured motion since the previous frame: the true motion of the interval shifted by
+  /// odometry_error.time_offset, with its scale error and biases (OdometryErrorProcess), then
+  /// the white motion noise. Frame 0: identity with dt = 1 / rate_hz.
   MotionIncrement measured_motion;
   /// Exact motion since the previous frame; frame 0: identity with dt = 1 / rate_hz.
   MotionIncrement true_motion;
@@ -38,16 +44,22 @@ struct SimulatedFrame {
   std::vector<PointId> new_point_ids;
   /// Ids whose observation this frame is a gross outlier (scenario.outlier_fraction).
   std::vector<PointId> outlier_ids;
+  /// Ids of the observations this frame that lie on moving objects
+  /// (scenario.moving_point_fraction; ascending, a subset of observations).
+  std::vector<PointId> moving_ids;
   /// True calibration at this frame.
   StereoExtrinsics truth;
-  /// True vehicle pose T_world_veh.
+  /// True vehicle pose T_world_veh (= MeasurementSimulator::truePose(stamp)).
   Eigen::Isometry3d T_world_veh = Eigen::Isometry3d::Identity();
+  /// The frame is one of scenario.blind_frames: no observations, every track died.
+  bool blind = false;
 };
 
 /// Produces the frames of a MeasurementScenario one by one. Deterministic for a given
-/// scenario (seed included). The track structure (births, losses), the pixel noise and the
-/// motion noise come from separate random streams, so changing a noise level does not change
-/// which points exist.
+/// scenario (seed included). The track structure (births, losses), the pixel noise, the
+/// motion noise, the odometry biases (stream 4) and the moving-point draws (stream 5) come
+/// from separate random streams, so changing a noise level or an odometry error does not
+/// change which points exist, and features left at zero leave the frames bit-identical.
 class MeasurementSimulator {
  public:
   /// @throws std::invalid_argument listing validate() problems.
@@ -63,15 +75,34 @@ class MeasurementSimulator {
   const MeasurementScenario& scenario() const { return scenario_; }
   const CameraModel& leftCamera() const { return left_; }
   const CameraModel& rightCamera() const { return right_; }
+  /// The analytic profile (scenario.motion, stops included). With a recorded_trajectory it
+  /// is NOT the drive: use truePose() and groundTrack(), which follow either.
   const VehicleTrajectory& trajectory() const { return trajectory_; }
+
+  /// True vehicle pose T_world_veh at drive time t (s, 0 at frame 0; any t for the analytic
+  /// profile). With a recorded_trajectory: its pose at firstStamp + recorded_start_offset + t
+  /// (linear + SLERP). @throws std::out_of_range if t lies outside the recording.
+  Eigen::Isometry3d truePose(double t) const;
+  /// True motion T_veh(t0)_veh(t1) = truePose(t0)^-1 * truePose(t1); exactly the identity
+  /// while the vehicle stands in a stop.
+  Eigen::Isometry3d trueMotion(double t0, double t1) const;
+  /// The vehicle's world x-y positions over the drive [0, frames / rate_hz] (clamped to the
+  /// recording), for SceneConfig::path of the image-level renderer: at most 1 m apart for
+  /// the analytic profile (the scene decimates to 1 m), every recorded pose in between for a
+  /// recorded trajectory.
+  std::vector<Eigen::Vector2d> groundTrack() const;
 
   /// Truth at frame 0 + initial_error (parameter space).
   StereoExtrinsics initialGuess() const;
   /// True calibration at any frame (also those not produced yet).
   StereoExtrinsics truthAt(int frame) const;
 
-  /// True world position of a point ever born (also after it died), for tests.
+  /// True world position at its birth of a point ever born (also after it died), for tests.
+  /// A static point stays there; see worldPointAt() for points on moving objects.
   std::optional<Eigen::Vector3d> worldPoint(PointId id) const;
+  /// True world position of a point ever born at drive time t (s): its birth position plus
+  /// its velocity (zero unless on a moving object) times (t - birth time).
+  std::optional<Eigen::Vector3d> worldPointAt(PointId id, double t) const;
 
   /// Number of tracks alive after the last frame (before any later dropTracks()).
   int liveTrackCount() const { return static_cast<int>(live_.size()); }
@@ -79,9 +110,19 @@ class MeasurementSimulator {
   int framesProduced() const { return next_frame_; }
 
  private:
+  /// A point ever born: where and when, and its velocity (m/s, world; zero if static).
+  struct BornPoint {
+    Eigen::Vector3d position;
+    double birth_time;
+    Eigen::Vector3d velocity;
+    bool moving;
+    Eigen::Vector3d at(double t) const {
+      return moving ? Eigen::Vector3d(position + (t - birth_time) * velocity) : position;
+    }
+  };
   struct Track {
     PointId id;
-    Eigen::Vector3d point_world;
+    BornPoint point;
   };
   /// The transforms that map world points into both optical frames at one frame.
   struct StereoView {
@@ -109,19 +150,25 @@ class MeasurementSimulator {
   StereoObservation observe(PointId id, const StereoPixels& pixels, SimulatedFrame* frame);
   Eigen::Vector2d outlierPixel(const Eigen::Vector2d& pixel, const CameraModel& camera);
   void advanceTracks(const StereoView& view, SimulatedFrame* frame);
+  /// Velocity of a point born now: on a moving object with moving_point_fraction.
+  std::optional<Eigen::Vector3d> drawMovingVelocity();
   void birthTracks(const StereoView& view, SimulatedFrame* frame);
 
   MeasurementScenario scenario_;
   VehicleTrajectory trajectory_;
+  /// The recorded drive (scenario.recorded_trajectory) and the stamp of frame 0 in it.
+  std::shared_ptr<const PoseTrajectory> recorded_;
+  double recorded_start_ = 0.0;
   CameraModel left_, right_;
-  RandomStream track_rng_;   ///< births and random losses
-  RandomStream pixel_rng_;   ///< pixel noise and outliers
-  RandomStream motion_rng_;  ///< motion noise
+  RandomStream track_rng_;               ///< births and random losses
+  RandomStream pixel_rng_;               ///< pixel noise and outliers
+  RandomStream motion_rng_;              ///< motion noise
+  RandomStream moving_rng_;              ///< which born points move, and where (stream 5)
+  OdometryErrorProcess odometry_error_;  ///< scale error and biases (stream 4)
   int next_frame_ = 0;
-  Eigen::Isometry3d previous_pose_ = Eigen::Isometry3d::Identity();
   std::vector<Track> live_;
-  /// World point of every track ever born, indexed by id - 1 (ids are 1, 2, 3, ...).
-  std::vector<Eigen::Vector3d> born_points_;
+  /// Every point ever born, indexed by id - 1 (ids are 1, 2, 3, ...).
+  std::vector<BornPoint> born_points_;
 };
 
 }  // namespace osc

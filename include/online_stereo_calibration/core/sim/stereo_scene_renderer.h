@@ -21,6 +21,11 @@
 
 namespace osc {
 
+/// Exposure gain of the images of a blind frame (MeasurementScenario::blind_frames): the
+/// scene at 2 % of its brightness, a few grey levels under the usual pixel noise, so that
+/// the front end finds no feature (darkness, a texture-poor view).
+constexpr double kBlindFrameExposureGain = 0.02;
+
 /// How one image is produced from the scene.
 struct RenderOptions {
   /// Standard deviation of additive Gaussian pixel noise, in grey levels (0-255 scale).

@@ -18,6 +18,15 @@ namespace osc {
 /// - the ground track (x, y) is the integral of speed * (cos yaw, sin yaw): constant speed;
 /// - roll, pitch and heave (z) are sinusoids of their own periods (zero when planar);
 /// - rotation R = Rz(yaw) * Ry(pitch) * Rx(roll).
+///
+/// Stops (profile.stops) are a time warp: every quantity at drive time t is the analytic
+/// profile's at the profile time s(t) (profileTime()), whose rate s'(t) (profileRate()) is 1
+/// while driving, 0 inside a stop, and moves between them along a smoothstep
+/// 3u^2 - 2u^3 (u = fraction of the ramp) over stop_ramp seconds before the stop
+/// (slow-down) and after it (speed-up). So the speed is speed * s'(t), continuous (C1
+/// poses) for stop_ramp > 0; each ramp costs stop_ramp / 2 of profile time and each stop
+/// its duration: after a stop, s(t) = t - sum(duration + stop_ramp). Without stops s(t) = t
+/// exactly (the poses are bit-identical to a profile without the feature).
 class VehicleTrajectory {
  public:
   /// @throws std::invalid_argument if a period is not positive or a value not finite.
@@ -25,8 +34,16 @@ class VehicleTrajectory {
 
   /// T_world_veh at time t (s).
   Eigen::Isometry3d pose(double t) const;
+  /// Motion of the vehicle from t0 to t1, T_veh(t0)_veh(t1) = pose(t0)^-1 * pose(t1); exactly
+  /// the identity when the profile clock stands still in between (both inside one stop).
+  Eigen::Isometry3d motionBetween(double t0, double t1) const;
 
-  /// Heading (rad) at time t.
+  /// Profile time s(t) (s) of drive time t: t minus the time lost to the stops up to t.
+  double profileTime(double t) const;
+  /// Rate ds/dt in [0, 1] at drive time t: the speed is profile().speed times this.
+  double profileRate(double t) const;
+
+  /// Heading (rad) at (drive) time t; likewise roll, pitch, heave and groundPosition.
   double yaw(double t) const;
   /// Body roll (rad) at time t.
   double roll(double t) const;
@@ -40,7 +57,11 @@ class VehicleTrajectory {
   const VehicleMotionProfile& profile() const { return profile_; }
 
  private:
-  /// Integral of speed * (cos yaw, sin yaw) over [0, tau], by Gauss-Legendre quadrature.
+  /// The analytic profile at profile time s (no stops).
+  double analyticYaw(double s) const;
+  Eigen::Vector2d analyticGroundPosition(double s) const;
+  /// Integral of speed * (cos yaw, sin yaw) over profile times [0, tau], by Gauss-Legendre
+  /// quadrature.
   Eigen::Vector2d integrateGroundTrack(double tau) const;
 
   VehicleMotionProfile profile_;

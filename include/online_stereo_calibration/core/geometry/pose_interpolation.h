@@ -1,11 +1,11 @@
 /// @file pose_interpolation.h
-/// @brief Stamped pose sequences (odometry, TUM trajectories) and their interpolation to
-/// arbitrary stamps: linear in translation, SLERP in rotation. Eigen only, no ROS, so the
-/// offline tools and the nodelet share it.
+/// @brief Stamped pose sequences (odometry, recorded trajectories) and their interpolation to
+/// arbitrary stamps: linear in translation, SLERP in rotation. Eigen only, no ROS and no file
+/// I/O (tools/tum_trajectory.h reads TUM files), so the core simulator, the offline tools and
+/// the nodelet share it.
 #pragma once
 
 #include <optional>
-#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -58,10 +58,5 @@ class PoseTrajectory {
  private:
   std::vector<StampedPose> poses_;
 };
-
-/// Reads a TUM trajectory file: lines `t x y z qx qy qz qw` (pose of the body in the world),
-/// '#' comments and blank lines skipped. @throws std::runtime_error naming the file and line
-/// (unreadable, wrong field count, non-number, zero quaternion, stamps not increasing).
-PoseTrajectory readTumTrajectory(const std::string& path);
 
 }  // namespace osc
