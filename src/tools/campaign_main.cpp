@@ -1,0 +1,216 @@
+// campaign: many simulated drives drawn from ranges, each scored for the filter's honesty
+// (issue 13; docs/campaign.md).
+//
+//   campaign --runs N --out DIR [--seed S] [--jobs J] [--frames F] [--images]
+//            [--ranges FILE] [--config PARAMS.yaml] [--only K]
+//
+// Writes DIR/campaign.csv (one row per run), DIR/summary.txt, DIR/campaign.png, the rows of
+// single runs in DIR/runs/ and the campaign's inputs in DIR/inputs/; --only K replays run K
+// into DIR/run_K/ (estimates.csv, reference.csv, plots, settings.txt).
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+#include <string>
+
+#include "online_stereo_calibration/tools/campaign.h"
+#include "online_stereo_calibration/tools/campaign_ranges.h"
+#include "online_stereo_calibration/tools/command_line.h"
+#include "online_stereo_calibration/tools/estimates_csv.h"
+#include "online_stereo_calibration/tools/output_directory.h"
+#include "online_stereo_calibration/tools/package_files.h"
+
+namespace {
+
+struct Options {
+  int runs = -1;
+  std::string out;
+  int seed = 1;
+  int jobs = 1;
+  int frames = 600;
+  bool images = false;
+  std::string ranges;
+  std::string config;
+  int only = -1;
+};
+
+const char* kDescription =
+    "Draws N scenarios from ranges (rig, motion, start errors, events, odometry errors, scene,\n"
+    "images; see docs/campaign.md and config/campaign.yaml, which documents every key),\n"
+    "reproducibly (run k uses seed S + k), simulates each, runs the estimator with --config\n"
+    "and scores it against the truth. Measurement level by default (simulated pixel tracks,\n"
+    "seconds per run); --images renders the drive and runs the whole pipeline (front end +\n"
+    "filter), as simulate + evaluate do. Frames at 10 Hz.\n"
+    "\n"
+    "J runs at once, each in its own process; a progress bar (runs done, ETA, runs honest so\n"
+    "far) on stderr. Re-running with the same DIR skips the finished runs (a larger N adds\n"
+    "runs); DIR/inputs keeps ranges, configuration, frames, seed and --images, and a DIR made\n"
+    "with other inputs is refused. A run that fails or crashes is recorded as failed.\n"
+    "\n"
+    "DIR/campaign.csv, one row per run: run,seed,frames,share_within_3sigma,\n"
+    "frames_beyond_5sigma,max_z,max_z_parameter,first_frame_beyond_5sigma,nees_mean,\n"
+    "converged_frame,time_ms_median, rmse_<p> for the 12 parameters over the last 150 frames\n"
+    "(m, rad), the drawn settings, run_s (wall time of the run) and status (ok / failed: why).\n"
+    "  share_within_3sigma: share of frames from frame 30 on with all 12 errors (estimate -\n"
+    "    truth, angles wrapped) within 3 reported sigmas; frames_beyond_5sigma: frames from 30\n"
+    "    on with some error beyond 5 sigma (first_frame_beyond_5sigma: the first, -1 if none);\n"
+    "  max_z: largest |error| / sigma from frame 30 on, max_z_parameter its parameter;\n"
+    "  nees_mean: mean from frame 30 on of the 12-dof NEES / 12 (about 1 when honest);\n"
+    "  converged_frame: first frame in the CONVERGED state (convergence.h), -1 if never;\n"
+    "  time_ms_median: median estimator time per frame (ms).\n"
+    "Drawn settings: baseline_m, image_width, image_height, focal_px, lens, k1, mounting,\n"
+    "pitch_down_deg, motion, trajectory, trajectory_start_s, speed_mps, roll_pitch_std_deg,\n"
+    "heave_m, yaw_rate_deg_s, stops, stop_s, start_caml_m, start_caml_deg (largest |error|\n"
+    "per axis), start_baseline_percent, start_camr_m, start_camr_deg, event, event_frame,\n"
+    "event_deg, event_mm_per_min, odo_time_offset_ms, odo_scale_percent,\n"
+    "odo_rotation_bias_deg_s, odo_velocity_bias_mps, blind_s, moving_fraction,\n"
+    "moving_speed_mps; with --images also image_noise, image_blur_px, image_flicker.\n"
+    "DIR/summary.txt: runs, share honest (share_within_3sigma >= 0.95 and\n"
+    "frames_beyond_5sigma = 0), the worst runs with seeds and settings, and the same by each\n"
+    "setting's bucket. DIR/campaign.png (scripts/plot_campaign.py): share_within_3sigma and\n"
+    "max_z against start errors, baseline, motion, mounting and event.";
+
+osc::CommandLine commandLine(Options* o) {
+  osc::CommandLine cli("campaign", kDescription);
+  cli.option("--runs", &o->runs, "N", "number of runs (required unless --only)")
+      .range(1, 1e6)
+      .defaultText("");
+  cli.option("--out", &o->out, "DIR", "campaign directory").required();
+  cli.option("--seed", &o->seed, "S", "seed of run 0; run k uses S + k").range(0, 2147483647);
+  cli.option("--jobs", &o->jobs, "J", "runs at once, in separate processes").range(1, 256);
+  cli.option("--frames", &o->frames, "F",
+             "frames per run at 10 Hz (scored from frame 30, RMSE over the last 150)")
+      .range(31, 1e6);
+  cli.flag("--images", &o->images,
+           "render the drives and run the whole pipeline (front end + filter; slow)");
+  cli.option("--ranges", &o->ranges, "FILE",
+             "ranges YAML replacing the shipped config/campaign.yaml (keys not given keep its "
+             "defaults)")
+      .defaultText("config/campaign.yaml");
+  cli.option("--config", &o->config, "PARAMS.yaml",
+             "estimator parameters (config/default.yaml keys, front_end: section)")
+      .defaultText("the shipped defaults");
+  cli.option("--only", &o->only, "K",
+             "replay run K alone into DIR/run_K: estimates.csv, reference.csv, the plots of "
+             "evaluate, settings.txt")
+      .range(0, 1e6)
+      .defaultText("");
+  return cli;
+}
+
+osc::CampaignInputs loadInputs(const Options& o) {
+  osc::CampaignInputs inputs;
+  std::string ranges_path = o.ranges;
+  if (ranges_path.empty()) {
+    ranges_path = osc::findPackageFile("config/campaign.yaml");
+    if (ranges_path.empty()) {
+      throw std::runtime_error("the shipped config/campaign.yaml was not found; give --ranges");
+    }
+  }
+  inputs.ranges_text = osc::readTextFile(ranges_path);
+  inputs.ranges = osc::readCampaignRangesFile(ranges_path);
+  if (!o.config.empty()) inputs.config = osc::readEstimatorConfigFile(o.config);
+  inputs.frames = o.frames;
+  inputs.seed = static_cast<unsigned>(o.seed);
+  inputs.images = o.images;
+  return inputs;
+}
+
+/// --only K: the run alone, with the files and plots of `evaluate`.
+int replay(const osc::CampaignInputs& inputs, const std::string& out, int run) {
+  osc::makeDirectories(out);
+  osc::storeOrCheckCampaignInputs(out, inputs);
+  const osc::CampaignRunSpec spec = osc::drawCampaignRun(inputs, run);
+  const std::string dir = out + "/run_" + std::to_string(run);
+  osc::makeDirectories(dir);
+  std::cerr << "campaign: replaying run " << run << " (seed " << spec.seed << ", "
+            << spec.scenario.frames << " frames" << (inputs.images ? ", images" : "") << ") into "
+            << dir << "\n";
+  osc::EstimatesCsvWriter estimates(dir + "/estimates.csv");
+  osc::ReferenceCsvWriter reference(dir + "/reference.csv");
+  const auto on_frame = [&](const osc::ScenarioFrameResult& r) {
+    osc::EstimateRow e;
+    e.frame = r.frame;
+    e.stamp = r.stamp;
+    e.parameters = r.parameters;
+    e.sigmas = r.sigmas;
+    e.tracked_points = r.tracked_points;
+    e.time_ms = r.time_ms;
+    estimates.write(e);
+    osc::ReferenceRow ref;
+    ref.frame = r.frame;
+    ref.stamp = r.stamp;
+    ref.parameters = r.truth;
+    reference.write(ref);
+  };
+  osc::CampaignRow row;
+  try {
+    row.score = osc::scoreCampaignRun(
+        osc::simulateCampaignRun(spec, inputs.config, inputs.images, on_frame));
+  } catch (const std::exception& e) {
+    row = osc::failedCampaignRow(run, spec.seed, inputs.frames, spec.settings, e.what());
+  }
+  row.run = run;
+  row.seed = spec.seed;
+  row.frames = inputs.frames;
+  row.settings = spec.settings;
+  estimates.flush();
+  reference.flush();
+
+  const std::vector<std::string> names = osc::campaignSettingNames(inputs.images);
+  osc::writeFileAtomic(dir + "/run.csv", osc::campaignCsvHeader(names) + "\n" +
+                                             osc::formatCampaignCsvLine(row, names) + "\n");
+  std::ostringstream text;
+  text << "run " << run << ", seed " << spec.seed << ", " << inputs.frames << " frames at 10 Hz"
+       << (inputs.images ? ", images" : ", measurement level") << ": "
+       << (row.ok() ? (row.honest() ? "honest" : "NOT honest") : row.status) << "\n"
+       << "share_within_3sigma " << row.score.share_within_3sigma << ", frames_beyond_5sigma "
+       << row.score.frames_beyond_5sigma << ", max_z " << row.score.max_z << " ("
+       << row.score.max_z_parameter << "), first_frame_beyond_5sigma "
+       << row.score.first_frame_beyond_5sigma << ", nees_mean " << row.score.nees_mean
+       << ", converged_frame " << row.score.converged_frame << "\n\ndrawn settings:\n";
+  for (const auto& [name, value] : spec.settings) text << "  " << name << " = " << value << "\n";
+  std::cout << text.str();
+  osc::writeFileAtomic(dir + "/settings.txt", text.str());
+
+  const std::string script = osc::findPackageFile("scripts/plot_convergence.py", "OSC_PLOT_SCRIPT");
+  if (script.empty()) {
+    std::cerr << "campaign: warning: scripts/plot_convergence.py not found; no plots\n";
+  } else {
+    std::string command = "/usr/bin/python3 '" + script + "' --out '" + dir + "'";
+    if (spec.scenario.step_frame >= 0) {
+      command += " --step-frame " + std::to_string(spec.scenario.step_frame);
+    }
+    if (std::system(command.c_str()) != 0) {
+      std::cerr << "campaign: warning: the plots failed (" << command << ")\n";
+    }
+  }
+  std::cout << "wrote " << dir << "/estimates.csv, reference.csv, run.csv, settings.txt, plots\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options parsed;
+  osc::CommandLine cli = commandLine(&parsed);
+  return osc::runTool(
+      "campaign", [&] { return cli.usage(); },
+      [&] {
+        if (!cli.parse(argc, argv)) return 0;
+        if (parsed.only < 0 && parsed.runs < 1) {
+          throw osc::CommandLineError("--runs is required (or --only K)");
+        }
+        const osc::CampaignInputs inputs = loadInputs(parsed);
+        if (parsed.only >= 0) return replay(inputs, parsed.out, parsed.only);
+        osc::CampaignOptions options;
+        options.runs = parsed.runs;
+        options.jobs = parsed.jobs;
+        options.out = parsed.out;
+        const std::vector<osc::CampaignRow> rows = osc::runCampaign(inputs, options);
+        int honest = 0;
+        for (const osc::CampaignRow& row : rows) honest += row.honest();
+        std::cout << "campaign: " << honest << " of " << rows.size() << " runs honest; wrote "
+                  << parsed.out << "/campaign.csv, summary.txt, campaign.png\n";
+        return 0;
+      });
+}
