@@ -243,19 +243,18 @@ TEST(CampaignDraw, RecordedTrajectoryStretchLiesInTheFile) {
       parseCampaignRanges("trajectories_dir: " + dir.path() + "\nmotion: {kind: recorded}", "t");
   for (int run = 0; run < 20; ++run) {
     const CampaignRunSpec spec = drawCampaignRun(ranges, run, run, 300, false);
+    EXPECT_TRUE(spec.error.empty()) << spec.error;
     ASSERT_TRUE(spec.scenario.recorded_trajectory);
     EXPECT_DOUBLE_EQ(spec.scenario.recorded_trajectory->firstStamp(), 100.0);
     EXPECT_GE(spec.scenario.recorded_start_offset, 0.0);
     EXPECT_LE(spec.scenario.recorded_start_offset + 30.0, 100.0);
     EXPECT_EQ(spec.settings[9].second, "line");
   }
-  // A drive longer than the recording fails the draw with a message naming the file.
-  try {
-    drawCampaignRun(ranges, 0, 0, 2000, false);
-    FAIL() << "no error";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("line.tum"), std::string::npos);
-  }
+  // A drive longer than the recording: the run cannot be made, the error names the file, the
+  // settings are all there.
+  const CampaignRunSpec too_long = drawCampaignRun(ranges, 0, 0, 2000, false);
+  EXPECT_NE(too_long.error.find("line.tum"), std::string::npos) << too_long.error;
+  EXPECT_EQ(too_long.settings.size(), campaignSettingNames(false).size());
 }
 
 ScenarioFrameResult frameWithErrors(int index, const Vector12d& z) {
@@ -440,6 +439,37 @@ TEST(Campaign, SameSeedGivesTheSameRows) {
     EXPECT_EQ(a[k].score.converged_frame, b[k].score.converged_frame);
   }
   EXPECT_NE(a[0].score.rmse, a[1].score.rmse);
+}
+
+// A run that cannot be made (here: the recording is shorter than the drive) is a failed row;
+// the campaign goes on and the summary counts it.
+TEST(Campaign, FailedRunsAreRecordedNotFatal) {
+  TempDir tum_dir, dir;
+  {
+    std::ofstream tum(tum_dir.path() + "/short.tum");
+    for (int i = 0; i <= 50; ++i) tum << 0.1 * i << " " << 0.5 * i << " 0 0 0 0 0 1\n";
+  }
+  const std::string ranges =
+      "trajectories_dir: " + tum_dir.path() + "\nmotion: {kind: {offroad: 1, recorded: 1}}\n";
+  const std::vector<CampaignRow> rows =
+      runCampaign(inputsFor(ranges, 100, 3), quietOptions(dir.path(), 6, 2));
+  ASSERT_EQ(rows.size(), 6u);
+  int failed = 0;
+  for (const CampaignRow& row : rows) {
+    const bool recorded = !row.settings.empty() && row.settings[8].second == "recorded";
+    EXPECT_EQ(row.ok(), !recorded) << row.status;
+    if (row.ok()) continue;
+    ++failed;
+    EXPECT_NE(row.status.find("shorter than the drive"), std::string::npos) << row.status;
+    EXPECT_TRUE(std::isnan(row.score.share_within_3sigma));
+    EXPECT_FALSE(row.honest());
+  }
+  EXPECT_GT(failed, 0);
+  EXPECT_LT(failed, 6);
+  EXPECT_NE(
+      readTextFile(dir.path() + "/summary.txt")
+          .find("(" + std::to_string(6 - failed) + " ran, " + std::to_string(failed) + " failed)"),
+      std::string::npos);
 }
 
 // The shipped configuration against one that declares the pixel noise 10x too small (the

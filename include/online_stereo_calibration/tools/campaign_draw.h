@@ -23,6 +23,9 @@ struct CampaignRunSpec {
   MeasurementScenario scenario;
   ImageScenarioOptions image_options;  ///< used with --images
   CampaignSettings settings;
+  /// Why the run cannot be made (e.g. a recorded trajectory unreadable or shorter than the
+  /// drive), "" if it can; the settings are complete either way.
+  std::string error;
 };
 
 /// The names of the drawn-setting columns, in order (docs/campaign.md explains each):
@@ -38,8 +41,8 @@ std::vector<std::string> campaignSettingNames(bool images);
 /// Draws run @p run with seed @p seed: every value from its range (uniform; kinds by weight),
 /// the same values for the same arguments on every machine (its own 64-bit generator and
 /// conversions). frames at 10 Hz.
-/// @throws std::runtime_error if a recorded trajectory cannot be read or is shorter than the
-/// drive.
+/// A recorded trajectory that cannot be read or is shorter than the drive sets `error`.
+/// @throws std::invalid_argument for ranges with `recorded` but no trajectory files.
 CampaignRunSpec drawCampaignRun(const CampaignRanges& ranges, int run, unsigned seed, int frames,
                                 bool images);
 

@@ -23,6 +23,9 @@ namespace osc {
 
 namespace {
 
+/// The status of a run whose process died (killed, crashed) starts so; such runs are retried.
+const std::string kProcessFailure = "failed: process ";
+
 bool exists(const std::string& path) {
   struct stat st;
   return stat(path.c_str(), &st) == 0;
@@ -90,6 +93,7 @@ CampaignRunSpec drawCampaignRun(const CampaignInputs& inputs, int run) {
 std::vector<ScenarioFrameResult> simulateCampaignRun(
     const CampaignRunSpec& spec, const EstimatorConfig& config, bool images,
     const std::function<void(const ScenarioFrameResult&)>& on_frame) {
+  if (!spec.error.empty()) throw std::runtime_error(spec.error);
   const std::vector<std::string> problems = spec.scenario.validate();
   if (!problems.empty()) {
     std::string message = "invalid scenario:";
@@ -170,13 +174,16 @@ std::vector<CampaignRow> runCampaign(const CampaignInputs& inputs, const Campaig
   std::vector<int> pending;
   int done = 0, honest = 0;
   for (int run = 0; run < options.runs; ++run) {
-    if (!exists(runFile(options.out, run))) {
+    const std::string file = runFile(options.out, run);
+    // A run whose process was killed or crashed is run again; any other row stays.
+    const std::vector<CampaignRow> rows =
+        exists(file) ? readCampaignCsv(file) : std::vector<CampaignRow>();
+    if (rows.empty() || rows.front().status.rfind(kProcessFailure, 0) == 0) {
       pending.push_back(run);
       continue;
     }
     ++done;
-    for (const CampaignRow& row : readCampaignCsv(runFile(options.out, run)))
-      honest += row.honest();
+    honest += rows.front().honest();
   }
   const int skipped = done;
   const bool tty = isatty(2);

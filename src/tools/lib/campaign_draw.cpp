@@ -231,18 +231,23 @@ CampaignRunSpec drawCampaignRun(const CampaignRanges& ranges, int run, unsigned 
     }
   } else {  // recorded
     const auto& files = ranges.trajectory_files;
-    if (files.empty()) throw std::runtime_error("motion 'recorded': no trajectory files");
+    if (files.empty()) throw std::invalid_argument("motion 'recorded': no trajectory files");
     const std::string& file =
         files[std::min(files.size() - 1, static_cast<size_t>(trajectory_pick * files.size()))];
-    auto recorded = std::make_shared<PoseTrajectory>(readTumTrajectory(file));
-    const double length = recorded->lastStamp() - recorded->firstStamp();
-    if (length < duration + 0.2) {
-      throw std::runtime_error("trajectory '" + file + "' lasts " + number(length) +
-                               " s, shorter than the drive of " + number(duration) + " s");
-    }
-    s.recorded_trajectory = recorded;
-    s.recorded_start_offset = trajectory_start * (length - duration - 0.2);
     trajectory = stem(file);
+    try {
+      auto recorded = std::make_shared<PoseTrajectory>(readTumTrajectory(file));
+      const double length = recorded->lastStamp() - recorded->firstStamp();
+      if (length < duration + 0.2) {
+        spec.error = "trajectory '" + file + "' lasts " + number(length) +
+                     " s, shorter than the drive of " + number(duration) + " s";
+      } else {
+        s.recorded_trajectory = recorded;
+        s.recorded_start_offset = trajectory_start * (length - duration - 0.2);
+      }
+    } catch (const std::exception& e) {
+      spec.error = e.what();
+    }
     trajectory_start_text = number(s.recorded_start_offset);
   }
   set("motion", motion);
