@@ -13,6 +13,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <opencv2/core/utility.hpp>
+
 #include "online_stereo_calibration/core/sim/image_scenario_runner.h"
 #include "online_stereo_calibration/core/sim/scenario_runner.h"
 #include "online_stereo_calibration/tools/campaign_summary.h"
@@ -63,8 +65,10 @@ std::string duration(double seconds) {
 }
 
 /// Runs one run in this (child) process and writes its row file; never returns.
-[[noreturn]] void runChild(const CampaignInputs& inputs, const std::string& dir, int run) {
+[[noreturn]] void runChild(const CampaignInputs& inputs, const std::string& dir, int run,
+                           int jobs) {
   int code = 0;
+  if (jobs > 1) cv::setNumThreads(1);  // J processes share the cores; no thread pool each
   try {
     const std::vector<std::string> names = campaignSettingNames(inputs.images);
     CampaignRow row;
@@ -218,7 +222,7 @@ std::vector<CampaignRow> runCampaign(const CampaignInputs& inputs, const Campaig
       std::fflush(nullptr);
       const pid_t pid = fork();
       if (pid < 0) throw std::runtime_error("fork failed");
-      if (pid == 0) runChild(inputs, options.out, run);
+      if (pid == 0) runChild(inputs, options.out, run, options.jobs);
       running[pid] = run;
     }
     int status = 0;
