@@ -350,6 +350,40 @@ TEST(CampaignCsv, RowsRoundTripAndFailedRowsKeepTheirColumns) {
   EXPECT_THROW(parseCampaignCsv("run,seed\n1,2\n", "bad.csv"), std::runtime_error);
 }
 
+TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
+  std::vector<CampaignRow> rows;
+  const std::vector<std::pair<std::string, std::string>> values = {
+      {"0", "a"}, {"1", "b"}, {"2", "a"}, {"3", "-"}, {"6", "a"}};
+  for (size_t i = 0; i < values.size(); ++i) {
+    CampaignRow row;
+    row.run = static_cast<int>(i);
+    row.settings = {{"x", values[i].first}, {"kind", values[i].second}};
+    row.score.share_within_3sigma = i == 1 ? 0.5 : 1.0;  // run 1 is not honest
+    row.score.max_z = static_cast<double>(i);
+    rows.push_back(row);
+  }
+  const std::vector<CampaignBucket> x = campaignBuckets(rows, "x");
+  ASSERT_EQ(x.size(), 3u);
+  EXPECT_EQ(x[0].label, "[0, 2)");
+  EXPECT_EQ(x[0].rows, (std::vector<int>{0, 1}));
+  EXPECT_EQ(x[1].rows, (std::vector<int>{2, 3}));
+  EXPECT_EQ(x[2].label, "[4, 6]");
+  EXPECT_EQ(x[2].rows, (std::vector<int>{4}));
+  const std::vector<CampaignBucket> kind = campaignBuckets(rows, "kind");
+  ASSERT_EQ(kind.size(), 3u);
+  EXPECT_EQ(kind[0].label, "-");
+  EXPECT_EQ(kind[1].label, "a");
+  EXPECT_EQ(kind[1].rows, (std::vector<int>{0, 2, 4}));
+  const std::string summary = formatCampaignSummary(rows, 1);
+  EXPECT_NE(
+      summary.find("Honest (share_within_3sigma >= 0.95 and frames_beyond_5sigma = 0): 4 of 5"),
+      std::string::npos)
+      << summary;
+  // The worst run listed first is the one that is not honest, though run 4 has a larger max_z.
+  EXPECT_NE(summary.find("run 1  seed 0  NOT honest"), std::string::npos) << summary;
+  EXPECT_EQ(summary.find("run 4  seed"), std::string::npos) << summary;
+}
+
 }  // namespace
 }  // namespace osc
 
