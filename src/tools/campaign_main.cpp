@@ -15,8 +15,6 @@
 #include "online_stereo_calibration/tools/campaign.h"
 #include "online_stereo_calibration/tools/campaign_ranges.h"
 #include "online_stereo_calibration/tools/command_line.h"
-#include "online_stereo_calibration/tools/estimates_csv.h"
-#include "online_stereo_calibration/tools/output_directory.h"
 #include "online_stereo_calibration/tools/package_files.h"
 
 namespace {
@@ -128,79 +126,6 @@ osc::CampaignInputs loadInputs(const Options& o) {
   return inputs;
 }
 
-/// --only K: the run alone, with the files and plots of `evaluate`.
-int replay(const osc::CampaignInputs& inputs, const std::string& out, int run) {
-  osc::makeDirectories(out);
-  osc::storeOrCheckCampaignInputs(out, inputs);
-  const osc::CampaignRunSpec spec = osc::drawCampaignRun(inputs, run);
-  const std::string dir = out + "/run_" + std::to_string(run);
-  osc::makeDirectories(dir);
-  std::cerr << "campaign: replaying run " << run << " (seed " << spec.seed << ", "
-            << spec.scenario.frames << " frames" << (inputs.images ? ", images" : "") << ") into "
-            << dir << "\n";
-  osc::EstimatesCsvWriter estimates(dir + "/estimates.csv");
-  osc::ReferenceCsvWriter reference(dir + "/reference.csv");
-  const auto on_frame = [&](const osc::ScenarioFrameResult& r) {
-    osc::EstimateRow e;
-    e.frame = r.frame;
-    e.stamp = r.stamp;
-    e.parameters = r.parameters;
-    e.sigmas = r.sigmas;
-    e.tracked_points = r.tracked_points;
-    e.time_ms = r.time_ms;
-    estimates.write(e);
-    osc::ReferenceRow ref;
-    ref.frame = r.frame;
-    ref.stamp = r.stamp;
-    ref.parameters = r.truth;
-    reference.write(ref);
-  };
-  osc::CampaignRow row;
-  try {
-    row.score = osc::scoreCampaignRun(
-        osc::simulateCampaignRun(spec, inputs.config, inputs.images, on_frame));
-  } catch (const std::exception& e) {
-    row = osc::failedCampaignRow(run, spec.seed, inputs.frames, spec.settings, e.what());
-  }
-  row.run = run;
-  row.seed = spec.seed;
-  row.frames = inputs.frames;
-  row.settings = spec.settings;
-  estimates.flush();
-  reference.flush();
-
-  const std::vector<std::string> names = osc::campaignSettingNames(inputs.images);
-  osc::writeFileAtomic(dir + "/run.csv", osc::campaignCsvHeader(names) + "\n" +
-                                             osc::formatCampaignCsvLine(row, names) + "\n");
-  std::ostringstream text;
-  text << "run " << run << ", seed " << spec.seed << ", " << inputs.frames << " frames at 10 Hz"
-       << (inputs.images ? ", images" : ", measurement level") << ": "
-       << (row.ok() ? (row.honest() ? "honest" : "NOT honest") : row.status) << "\n"
-       << "share_within_3sigma " << row.score.share_within_3sigma << ", frames_beyond_5sigma "
-       << row.score.frames_beyond_5sigma << ", max_z " << row.score.max_z << " ("
-       << row.score.max_z_parameter << "), first_frame_beyond_5sigma "
-       << row.score.first_frame_beyond_5sigma << ", nees_mean " << row.score.nees_mean
-       << ", converged_frame " << row.score.converged_frame << "\n\ndrawn settings:\n";
-  for (const auto& [name, value] : spec.settings) text << "  " << name << " = " << value << "\n";
-  std::cout << text.str();
-  osc::writeFileAtomic(dir + "/settings.txt", text.str());
-
-  const std::string script = osc::findPackageFile("scripts/plot_convergence.py", "OSC_PLOT_SCRIPT");
-  if (script.empty()) {
-    std::cerr << "campaign: warning: scripts/plot_convergence.py not found; no plots\n";
-  } else {
-    std::string command = "/usr/bin/python3 '" + script + "' --out '" + dir + "'";
-    if (spec.scenario.step_frame >= 0) {
-      command += " --step-frame " + std::to_string(spec.scenario.step_frame);
-    }
-    if (std::system(command.c_str()) != 0) {
-      std::cerr << "campaign: warning: the plots failed (" << command << ")\n";
-    }
-  }
-  std::cout << "wrote " << dir << "/estimates.csv, reference.csv, run.csv, settings.txt, plots\n";
-  return 0;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -214,7 +139,10 @@ int main(int argc, char** argv) {
           throw osc::CommandLineError("--runs is required (or --only K)");
         }
         const osc::CampaignInputs inputs = loadInputs(parsed);
-        if (parsed.only >= 0) return replay(inputs, parsed.out, parsed.only);
+        if (parsed.only >= 0) {
+          osc::replayCampaignRun(inputs, parsed.out, parsed.only, true, &std::cout);
+          return 0;
+        }
         osc::CampaignOptions options;
         options.runs = parsed.runs;
         options.jobs = parsed.jobs;

@@ -15,6 +15,7 @@
 #include "online_stereo_calibration/tools/campaign_ranges.h"
 #include "online_stereo_calibration/tools/campaign_score.h"
 #include "online_stereo_calibration/tools/campaign_summary.h"
+#include "online_stereo_calibration/tools/estimates_csv.h"
 #include "online_stereo_calibration/tools/pose_interpolation.h"
 
 namespace osc {
@@ -454,6 +455,40 @@ TEST(Campaign, FourRunsOf100FramesWriteTheDocumentedColumnsAndResume) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("the ranges"), std::string::npos) << e.what();
   }
+}
+
+// --only K gives the campaign's row of run K, with the per-frame files of evaluate.
+TEST(Campaign, ReplayOfARunGivesItsRowAndPerFrameFiles) {
+  TempDir dir;
+  const CampaignInputs inputs = inputsFor(kNoRecorded, 100, 20);
+  const std::vector<CampaignRow> rows = runCampaign(inputs, quietOptions(dir.path(), 2, 2));
+  const CampaignRow replayed = replayCampaignRun(inputs, dir.path(), 1, false);
+  EXPECT_EQ(replayed.seed, 21u);
+  EXPECT_EQ(replayed.settings, rows[1].settings);
+  // The campaign's rows come from its CSV (10 significant digits).
+  EXPECT_NEAR(replayed.score.share_within_3sigma, rows[1].score.share_within_3sigma, 1e-9);
+  EXPECT_NEAR(replayed.score.max_z, rows[1].score.max_z, 1e-8 * rows[1].score.max_z);
+  EXPECT_EQ(replayed.score.frames_beyond_5sigma, rows[1].score.frames_beyond_5sigma);
+  for (int p = 0; p < 12; ++p) {
+    EXPECT_NEAR(replayed.score.rmse[p], rows[1].score.rmse[p], 1e-8 * rows[1].score.rmse[p]);
+  }
+  const std::string run_dir = dir.path() + "/run_1";
+  const std::vector<EstimateRow> estimates = readEstimatesCsv(run_dir + "/estimates.csv");
+  const std::vector<ReferenceRow> reference = readReferenceCsv(run_dir + "/reference.csv");
+  ASSERT_EQ(estimates.size(), 100u);
+  ASSERT_EQ(reference.size(), 100u);
+  // The RMSE of xl over the last 150 (here all 100) frames, from the files.
+  double sum = 0.0;
+  for (size_t i = 0; i < estimates.size(); ++i) {
+    const double e = estimates[i].parameters(0) - reference[i].parameters(0);
+    sum += e * e;
+  }
+  EXPECT_NEAR(std::sqrt(sum / 100.0), replayed.score.rmse[0], 1e-12);
+  EXPECT_EQ(readCampaignCsv(run_dir + "/run.csv").size(), 1u);
+  EXPECT_NE(readTextFile(run_dir + "/settings.txt").find("seed 21"), std::string::npos);
+  // A replay with other inputs is refused.
+  EXPECT_THROW(replayCampaignRun(inputsFor(kNoRecorded, 100, 21), dir.path(), 1, false),
+               std::runtime_error);
 }
 
 TEST(Campaign, SameSeedGivesTheSameRows) {

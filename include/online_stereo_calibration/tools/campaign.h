@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -55,5 +56,13 @@ void storeOrCheckCampaignInputs(const std::string& dir, const CampaignInputs& in
 /// (sorted by run), DIR/summary.txt and (options.plot) DIR/campaign.png. Returns the rows.
 /// @throws std::runtime_error for bad inputs or a DIR of another campaign.
 std::vector<CampaignRow> runCampaign(const CampaignInputs& inputs, const CampaignOptions& options);
+
+/// --only K: runs run @p run alone (in this process) into DIR/run_K/: estimates.csv and
+/// reference.csv (the per-frame estimate and truth, estimates_csv.h), run.csv (its campaign
+/// row), settings.txt (scores and drawn settings, also written to @p report if given) and,
+/// with @p plot, the plots of scripts/plot_convergence.py as `evaluate` makes them. The inputs
+/// are stored in or checked against DIR (storeOrCheckCampaignInputs). Returns the row.
+CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& out, int run,
+                              bool plot, std::ostream* report = nullptr);
 
 }  // namespace osc
