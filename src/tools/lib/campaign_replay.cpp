@@ -69,6 +69,7 @@ CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& o
   if (report) *report << text.str();
   writeFileAtomic(dir + "/settings.txt", text.str());
 
+  if (report) report->flush();  // before the script's own output
   const std::string script =
       plot ? findPackageFile("scripts/plot_convergence.py", "OSC_PLOT_SCRIPT") : "";
   if (!plot) {
