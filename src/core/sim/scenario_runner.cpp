@@ -4,12 +4,14 @@
 
 #include <Eigen/Cholesky>
 
+#include "online_stereo_calibration/core/estimator/convergence.h"
 #include "online_stereo_calibration/core/sim/measurement_simulator.h"
 
 namespace osc {
 
-ScenarioFrameResult makeFrameResult(const SimulatedFrame& frame, const CalibrationEstimate& estimate,
-                                    const FrameReport& report, double time_ms) {
+ScenarioFrameResult makeFrameResult(const SimulatedFrame& frame,
+                                    const CalibrationEstimate& estimate, const FrameReport& report,
+                                    double time_ms) {
   ScenarioFrameResult r;
   r.frame = frame.index;
   r.stamp = frame.stamp;
@@ -23,19 +25,27 @@ ScenarioFrameResult makeFrameResult(const SimulatedFrame& frame, const Calibrati
   r.tracked_points = static_cast<int>(estimate.tracked_points);
   r.new_points = report.new_points;
   r.jump_detected = report.step.jump != JumpBlock::kNone;
+  r.converged = isConverged(estimate, ConvergenceThresholds());
   r.time_ms = time_ms;
   return r;
 }
 
 std::vector<ScenarioFrameResult> runMeasurementScenario(
     const MeasurementScenario& scenario, const FilterConfig& config,
-    const std::function<void(const ScenarioFrameResult&)>& on_frame) {
+    const std::function<void(const ScenarioFrameResult&)>& on_frame,
+    bool declare_config_pixel_noise) {
   MeasurementSimulator simulator(scenario);
-  StereoCalibrationEstimator estimator(config, scenario.left, scenario.right, simulator.initialGuess());
+  StereoCalibrationEstimator estimator(config, scenario.left, scenario.right,
+                                       simulator.initialGuess());
   std::vector<ScenarioFrameResult> results;
   results.reserve(scenario.frames);
   SimulatedFrame frame;
   while (simulator.nextFrame(&frame)) {
+    if (declare_config_pixel_noise) {
+      for (auto& observation : frame.observations) {
+        observation.sigma_left = observation.sigma_right = 0.0;
+      }
+    }
     const auto start = std::chrono::steady_clock::now();
     const FrameReport report = estimator.processFrame(frame.measured_motion, frame.observations);
     const CalibrationEstimate estimate = estimator.estimate();

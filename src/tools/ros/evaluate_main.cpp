@@ -29,7 +29,6 @@
 #include <utility>
 
 #include <cv_bridge/cv_bridge.h>
-#include <ros/package.h>
 #include <sensor_msgs/Image.h>
 #include <opencv2/core/utility.hpp>
 
@@ -42,6 +41,7 @@
 #include "online_stereo_calibration/tools/estimator_config_yaml.h"
 #include "online_stereo_calibration/tools/evaluation.h"
 #include "online_stereo_calibration/tools/output_directory.h"
+#include "online_stereo_calibration/tools/package_files.h"
 
 namespace {
 
@@ -125,23 +125,6 @@ bool isFile(const std::string& path) {
 std::string directoryOf(const std::string& path) {
   const auto slash = path.find_last_of('/');
   return slash == std::string::npos ? "." : path.substr(0, slash);
-}
-
-/// scripts/plot_convergence.py: $OSC_PLOT_SCRIPT, the package path (ROS_PACKAGE_PATH), the
-/// current directory, or the source tree this executable was built from.
-std::string findPlotScript() {
-  std::vector<std::string> candidates;
-  if (const char* env = std::getenv("OSC_PLOT_SCRIPT")) candidates.push_back(env);
-  if (std::getenv("ROS_PACKAGE_PATH")) {  // rospack complains loudly without it
-    const std::string package = ros::package::getPath("online_stereo_calibration");
-    if (!package.empty()) candidates.push_back(package + "/scripts/plot_convergence.py");
-  }
-  candidates.push_back("scripts/plot_convergence.py");
-  candidates.push_back(directoryOf(__FILE__) + "/../../../scripts/plot_convergence.py");
-  for (const std::string& c : candidates) {
-    if (isFile(c)) return c;
-  }
-  return "";
 }
 
 cv::Mat toMat(const sensor_msgs::ImageConstPtr& msg, cv_bridge::CvImageConstPtr* holder) {
@@ -377,7 +360,7 @@ int evaluateBag(const Options& options) {
   std::cout << text.str();
   std::ofstream(options.out + "/table.txt") << text.str();
 
-  const std::string script = findPlotScript();
+  const std::string script = osc::findPackageFile("scripts/plot_convergence.py", "OSC_PLOT_SCRIPT");
   if (script.empty()) {
     std::cerr << "evaluate: warning: scripts/plot_convergence.py not found (set "
                  "OSC_PLOT_SCRIPT); no plots\n";

@@ -28,18 +28,25 @@ struct ScenarioFrameResult {
   int tracked_points = 0;
   int new_points = 0;
   bool jump_detected = false;
+  /// isConverged(estimate, ConvergenceThresholds()) after this frame (convergence.h).
+  bool converged = false;
   double time_ms = 0.0;  ///< estimator time for this frame
 };
 
 /// One frame's result from the estimate after it, the truth and the estimator's report.
-ScenarioFrameResult makeFrameResult(const SimulatedFrame& frame, const CalibrationEstimate& estimate,
-                                    const FrameReport& report, double time_ms);
+ScenarioFrameResult makeFrameResult(const SimulatedFrame& frame,
+                                    const CalibrationEstimate& estimate, const FrameReport& report,
+                                    double time_ms);
 
 /// Runs scenario through a StereoCalibrationEstimator starting from the scenario's initial
-/// guess; calls on_frame after each frame if given.
+/// guess; calls on_frame after each frame if given. Each observation carries the scenario's
+/// pixel_noise as its sigma, unless @p declare_config_pixel_noise: then it carries none and
+/// the estimator assumes config.pixel_noise (as for a front end that declares none), so that
+/// a configuration can be wrong about the noise the simulator adds.
 /// @throws std::invalid_argument for an invalid scenario or config.
 std::vector<ScenarioFrameResult> runMeasurementScenario(
     const MeasurementScenario& scenario, const FilterConfig& config,
-    const std::function<void(const ScenarioFrameResult&)>& on_frame = {});
+    const std::function<void(const ScenarioFrameResult&)>& on_frame = {},
+    bool declare_config_pixel_noise = false);
 
 }  // namespace osc

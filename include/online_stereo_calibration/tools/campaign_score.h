@@ -1,0 +1,52 @@
+/// @file campaign_score.h
+/// @brief Scoring one campaign run against its truth: is the filter honest about its errors
+/// (the errors within the sigmas it reports), how large are they, when did it converge.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "online_stereo_calibration/core/sim/scenario_runner.h"
+
+namespace osc {
+
+/// Frames before this one are not scored for honesty (the filter's first seconds).
+constexpr int kCampaignFirstScoredFrame = 30;
+/// The RMSE is taken over the last this many frames (fewer if the drive is shorter).
+constexpr int kCampaignRmseFrames = 150;
+
+/// The scores of one run (the first CSV columns after run, seed, frames). Errors are
+/// estimate - truth per parameter (interface order, m and rad, angles wrapped to
+/// (-pi, pi]); z = |error| / sigma with the filter's reported 1 sigma of that parameter.
+/// A NaN estimate or sigma counts as beyond every bound (z = +inf).
+struct CampaignScore {
+  /// Share of frames >= kCampaignFirstScoredFrame with all 12 |errors| <= 3 sigma.
+  double share_within_3sigma = 0.0;
+  /// Frames >= kCampaignFirstScoredFrame with some |error| > 5 sigma.
+  int frames_beyond_5sigma = 0;
+  /// Largest z over those frames and parameters ...
+  double max_z = 0.0;
+  /// ... and its parameter's name (xl .. yaw_r).
+  std::string max_z_parameter;
+  /// First frame >= kCampaignFirstScoredFrame with some |error| > 5 sigma; -1 if none.
+  int first_frame_beyond_5sigma = -1;
+  /// Mean over frames >= kCampaignFirstScoredFrame of the 12-dof NEES (tangent error with the
+  /// full covariance, ScenarioFrameResult::nees) / 12: about 1 when honest.
+  double nees_mean = 0.0;
+  /// First frame at which the state is CONVERGED (isConverged); -1 if never.
+  int converged_frame = -1;
+  /// Median estimator time per frame (ms).
+  double time_ms_median = 0.0;
+  /// RMSE of each parameter over the last kCampaignRmseFrames frames (m, rad).
+  std::array<double, 12> rmse{};
+};
+
+/// Scores a run's per-frame results (in frame order; at least one frame from
+/// kCampaignFirstScoredFrame on). @throws std::invalid_argument otherwise.
+CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames);
+
+/// The parameter names in interface order (xl, yl, zl, roll_l, ..., yaw_r).
+const std::array<std::string, 12>& campaignParameterNames();
+
+}  // namespace osc

@@ -1,0 +1,94 @@
+/// @file campaign_replay.cpp
+/// @brief --only K of `campaign`: one run alone with the files and plots of `evaluate`.
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+
+#include "online_stereo_calibration/tools/campaign.h"
+#include "online_stereo_calibration/tools/estimates_csv.h"
+#include "online_stereo_calibration/tools/output_directory.h"
+#include "online_stereo_calibration/tools/package_files.h"
+
+namespace osc {
+
+CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& out, int run,
+                              bool plot, std::ostream* report) {
+  makeDirectories(out);
+  storeOrCheckCampaignInputs(out, inputs);
+  const CampaignRunSpec spec = drawCampaignRun(inputs, run);
+  const std::string dir = out + "/run_" + std::to_string(run);
+  makeDirectories(dir);
+  if (report) {
+    *report << "campaign: replaying run " << run << " (seed " << spec.seed << ", "
+            << spec.scenario.frames << " frames" << (inputs.images ? ", images" : "") << ") into "
+            << dir << "\n";
+  }
+  EstimatesCsvWriter estimates(dir + "/estimates.csv");
+  ReferenceCsvWriter reference(dir + "/reference.csv");
+  const auto on_frame = [&](const ScenarioFrameResult& r) {
+    EstimateRow e;
+    e.frame = r.frame;
+    e.stamp = r.stamp;
+    e.parameters = r.parameters;
+    e.sigmas = r.sigmas;
+    e.tracked_points = r.tracked_points;
+    e.time_ms = r.time_ms;
+    estimates.write(e);
+    ReferenceRow ref;
+    ref.frame = r.frame;
+    ref.stamp = r.stamp;
+    ref.parameters = r.truth;
+    reference.write(ref);
+  };
+  CampaignRow row;
+  try {
+    row.score = scoreCampaignRun(simulateCampaignRun(spec, inputs.config, inputs.images, on_frame));
+  } catch (const std::exception& e) {
+    row = failedCampaignRow(run, spec.seed, inputs.frames, spec.settings, e.what());
+  }
+  row.run = run;
+  row.seed = spec.seed;
+  row.frames = inputs.frames;
+  row.settings = spec.settings;
+  estimates.flush();
+  reference.flush();
+
+  const std::vector<std::string> names = campaignSettingNames(inputs.images);
+  writeFileAtomic(dir + "/run.csv",
+                  campaignCsvHeader(names) + "\n" + formatCampaignCsvLine(row, names) + "\n");
+  std::ostringstream text;
+  text << "run " << run << ", seed " << spec.seed << ", " << inputs.frames << " frames at 10 Hz"
+       << (inputs.images ? ", images" : ", measurement level") << ": "
+       << (row.ok() ? (row.honest() ? "honest" : "NOT honest") : row.status) << "\n"
+       << "share_within_3sigma " << row.score.share_within_3sigma << ", frames_beyond_5sigma "
+       << row.score.frames_beyond_5sigma << ", max_z " << row.score.max_z << " ("
+       << row.score.max_z_parameter << "), first_frame_beyond_5sigma "
+       << row.score.first_frame_beyond_5sigma << ", nees_mean " << row.score.nees_mean
+       << ", converged_frame " << row.score.converged_frame << "\n\ndrawn settings:\n";
+  for (const auto& [name, value] : spec.settings) text << "  " << name << " = " << value << "\n";
+  if (report) *report << text.str();
+  writeFileAtomic(dir + "/settings.txt", text.str());
+
+  if (report) report->flush();  // before the script's own output
+  const std::string script =
+      plot ? findPackageFile("scripts/plot_convergence.py", "OSC_PLOT_SCRIPT") : "";
+  if (!plot) {
+  } else if (script.empty()) {
+    std::cerr << "campaign: warning: scripts/plot_convergence.py not found; no plots\n";
+  } else {
+    std::string command = "/usr/bin/python3 '" + script + "' --out '" + dir + "'";
+    if (spec.scenario.step_frame >= 0) {
+      command += " --step-frame " + std::to_string(spec.scenario.step_frame);
+    }
+    if (std::system(command.c_str()) != 0) {
+      std::cerr << "campaign: warning: the plots failed (" << command << ")\n";
+    }
+  }
+  if (report) {
+    *report << "wrote " << dir << "/estimates.csv, reference.csv, run.csv, settings.txt"
+            << (plot ? ", plots" : "") << "\n";
+  }
+  return row;
+}
+
+}  // namespace osc

@@ -1,0 +1,85 @@
+#include "online_stereo_calibration/tools/campaign_score.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace osc {
+
+namespace {
+
+double wrapAngle(double a) {
+  a = std::remainder(a, 2.0 * M_PI);  // [-pi, pi]
+  return a <= -M_PI ? a + 2.0 * M_PI : a;
+}
+
+bool isAngle(int index) { return index % 6 >= 3; }
+
+}  // namespace
+
+const std::array<std::string, 12>& campaignParameterNames() {
+  static const std::array<std::string, 12> names = {"xl", "yl", "zl", "roll_l", "pitch_l", "yaw_l",
+                                                    "xr", "yr", "zr", "roll_r", "pitch_r", "yaw_r"};
+  return names;
+}
+
+CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames) {
+  CampaignScore score;
+  const double inf = std::numeric_limits<double>::infinity();
+  int scored = 0, within = 0;
+  double nees_sum = 0.0;
+  int max_index = 0;
+  for (const ScenarioFrameResult& f : frames) {
+    if (f.converged && score.converged_frame < 0) score.converged_frame = f.frame;
+    if (f.frame < kCampaignFirstScoredFrame) continue;
+    ++scored;
+    bool all_within = true, some_beyond = false;
+    for (int p = 0; p < 12; ++p) {
+      double e = f.parameters(p) - f.truth(p);
+      if (isAngle(p)) e = wrapAngle(e);
+      double z = std::abs(e) / f.sigmas(p);
+      if (std::abs(e) == 0.0) z = 0.0;
+      if (!std::isfinite(e) || !(f.sigmas(p) >= 0.0) || std::isnan(z)) z = inf;
+      if (!(z <= 3.0)) all_within = false;
+      if (!(z <= 5.0)) some_beyond = true;
+      if (z > score.max_z) {
+        score.max_z = z;
+        max_index = p;
+      }
+    }
+    within += all_within;
+    if (some_beyond) {
+      ++score.frames_beyond_5sigma;
+      if (score.first_frame_beyond_5sigma < 0) score.first_frame_beyond_5sigma = f.frame;
+    }
+    nees_sum += f.nees / 12.0;
+  }
+  if (scored == 0) {
+    throw std::invalid_argument("scoreCampaignRun: no frame from frame " +
+                                std::to_string(kCampaignFirstScoredFrame) + " on");
+  }
+  score.share_within_3sigma = static_cast<double>(within) / scored;
+  score.max_z_parameter = campaignParameterNames()[max_index];
+  score.nees_mean = nees_sum / scored;
+
+  std::vector<double> times;
+  for (const ScenarioFrameResult& f : frames) times.push_back(f.time_ms);
+  std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
+  score.time_ms_median = times[times.size() / 2];
+
+  const size_t first =
+      frames.size() > kCampaignRmseFrames ? frames.size() - kCampaignRmseFrames : 0;
+  for (int p = 0; p < 12; ++p) {
+    double sum = 0.0;
+    for (size_t i = first; i < frames.size(); ++i) {
+      double e = frames[i].parameters(p) - frames[i].truth(p);
+      if (isAngle(p)) e = wrapAngle(e);
+      sum += e * e;
+    }
+    score.rmse[p] = std::sqrt(sum / (frames.size() - first));
+  }
+  return score;
+}
+
+}  // namespace osc

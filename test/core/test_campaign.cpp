@@ -1,0 +1,575 @@
+// Tests of the campaign tool's library (issue 13): ranges, drawing, scoring, the CSV, and
+// short campaigns (4 runs of 100 frames at measurement level).
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include "online_stereo_calibration/tools/campaign.h"
+#include "online_stereo_calibration/tools/campaign_csv.h"
+#include "online_stereo_calibration/tools/campaign_draw.h"
+#include "online_stereo_calibration/tools/campaign_ranges.h"
+#include "online_stereo_calibration/tools/campaign_score.h"
+#include "online_stereo_calibration/tools/campaign_summary.h"
+#include "online_stereo_calibration/tools/estimates_csv.h"
+#include "online_stereo_calibration/tools/pose_interpolation.h"
+
+namespace osc {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+/// A fresh directory under /tmp, removed with everything in it at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    char name[] = "/tmp/osc_test_campaign_XXXXXX";
+    const char* made = ::mkdtemp(name);
+    if (made == nullptr) throw std::runtime_error("mkdtemp failed");
+    path_ = made;
+  }
+  ~TempDir() { std::filesystem::remove_all(path_); }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+std::string parseError(const std::string& yaml) {
+  try {
+    parseCampaignRanges(yaml, "test.yaml");
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+/// Ranges without the recorded trajectories (which need files).
+const char* kNoRecorded = "motion: {kind: {offroad: 1, urban: 1}}\n";
+
+/// Easy ranges: a paper-like off-road drive with small start errors, no event, no odometry or
+/// scene trouble, a forward-looking pinhole rig.
+const char* kEasy =
+    "rig: {lens: pinhole, mounting: forward, forward_pitch_down_deg: [0, 5],"
+    " baseline_m: [0.2, 0.4], focal_px: [500, 700], image_width_px: 640}\n"
+    "motion: {kind: offroad, offroad_speed_mps: [3, 4], offroad_roll_pitch_std_deg: [1.5, 2]}\n"
+    "start_errors: {caml_translation_m: [0, 0.05], caml_angle_deg: [0, 1],"
+    " camr_baseline_percent: [-5, 5], camr_translation_m: [0, 0.005], camr_angle_deg: [0, 0.5]}\n"
+    "events: {kind: none}\n"
+    "odometry: {time_offset_ms: 0, scale_error_percent: 0, rotation_rate_bias_deg_s: 0,"
+    " velocity_bias_mps: 0}\n"
+    "scene: {blind_stretches: 0, moving_point_fraction: 0}\n";
+
+CampaignInputs inputsFor(const std::string& ranges_yaml, int frames, unsigned seed) {
+  CampaignInputs inputs;
+  inputs.ranges_text = ranges_yaml;
+  inputs.ranges = parseCampaignRanges(ranges_yaml, "test ranges");
+  inputs.frames = frames;
+  inputs.seed = seed;
+  return inputs;
+}
+
+CampaignOptions quietOptions(const std::string& out, int runs, int jobs) {
+  CampaignOptions options;
+  options.runs = runs;
+  options.jobs = jobs;
+  options.out = out;
+  options.progress = false;
+  options.plot = false;
+  return options;
+}
+
+TEST(CampaignRanges, ErrorsNameTheKey) {
+  EXPECT_NE(parseError(std::string(kNoRecorded) + "rig: {baseline: [0.1, 0.2]}")
+                .find("rig.baseline: unknown key"),
+            std::string::npos);
+  EXPECT_NE(parseError(std::string(kNoRecorded) + "rigs: {}").find("rigs: unknown key"),
+            std::string::npos);
+  EXPECT_NE(parseError(std::string(kNoRecorded) + "rig: {baseline_m: [0.5, 0.1]}")
+                .find("rig.baseline_m: [0.5, 0.1]: min > max"),
+            std::string::npos);
+  EXPECT_NE(parseError(std::string(kNoRecorded) + "images: {exposure_flicker: [0, 2]}")
+                .find("images.exposure_flicker"),
+            std::string::npos);
+  EXPECT_NE(parseError(std::string(kNoRecorded) + "scene: {blind_stretches: [0, 1.5]}")
+                .find("scene.blind_stretches: [0, 1.5] must be integers"),
+            std::string::npos);
+  EXPECT_NE(parseError(std::string(kNoRecorded) + "rig: {baseline_m: fast}")
+                .find("rig.baseline_m: 'fast' is not a number or [min, max]"),
+            std::string::npos);
+  EXPECT_NE(parseError("motion: {kind: {offroad: 1, flying: 1}}")
+                .find("motion.kind: unknown kind 'flying'"),
+            std::string::npos);
+  EXPECT_NE(parseError("motion: {kind: {offroad: 0}}").find("motion.kind: at least one weight"),
+            std::string::npos);
+  // The default kinds include `recorded`, which needs trajectories_dir.
+  EXPECT_NE(parseError("").find("trajectories_dir: not given"), std::string::npos);
+  EXPECT_NE(parseError("trajectories_dir: /nonexistent/dir")
+                .find("trajectories_dir: '/nonexistent/dir' is not a directory"),
+            std::string::npos);
+  // Every problem at once.
+  const std::string both =
+      parseError(std::string(kNoRecorded) + "rig: {baseline_m: [0.5, 0.1], focal: 3}");
+  EXPECT_NE(both.find("rig.baseline_m"), std::string::npos);
+  EXPECT_NE(both.find("rig.focal: unknown key"), std::string::npos);
+  // A fixed value and a single kind.
+  const CampaignRanges fixed = parseCampaignRanges(
+      std::string(kNoRecorded) + "rig: {baseline_m: 0.3, lens: equidistant}", "t");
+  EXPECT_EQ(fixed.baseline_m.min, 0.3);
+  EXPECT_EQ(fixed.baseline_m.max, 0.3);
+  EXPECT_EQ(fixed.lens.weight("equidistant"), 1.0);
+  EXPECT_EQ(fixed.lens.weight("pinhole"), 0.0);
+}
+
+TEST(CampaignRanges, ShippedFileStatesTheBuiltInDefaults) {
+  // Resolve trajectories_dir (../../shared/data/trajectories beside config/) in a scratch tree.
+  TempDir dir;
+  std::filesystem::create_directories(dir.path() + "/repo/config");
+  std::filesystem::create_directories(dir.path() + "/shared/data/trajectories");
+  std::ofstream(dir.path() + "/shared/data/trajectories/a.tum") << "# empty\n";
+  const std::string text = readTextFile(std::string(OSC_SOURCE_DIR) + "/config/campaign.yaml");
+  const CampaignRanges shipped =
+      parseCampaignRanges(text, "config/campaign.yaml", dir.path() + "/repo/config");
+  const CampaignRanges defaults;
+  for (const DrawRangeSpec& spec : drawRangeSpecs()) {
+    EXPECT_EQ((shipped.*spec.member).min, (defaults.*spec.member).min) << spec.key;
+    EXPECT_EQ((shipped.*spec.member).max, (defaults.*spec.member).max) << spec.key;
+  }
+  for (const KindChoiceSpec& spec : kindChoiceSpecs()) {
+    EXPECT_EQ((shipped.*spec.member).weights, (defaults.*spec.member).weights) << spec.key;
+  }
+  ASSERT_EQ(shipped.trajectory_files.size(), 1u);
+  EXPECT_NE(shipped.trajectory_files[0].find("a.tum"), std::string::npos);
+}
+
+TEST(CampaignDraw, ValuesStayInTheirRangesAndRepeatWithTheSeed) {
+  const CampaignRanges ranges = parseCampaignRanges(
+      std::string(kNoRecorded) + "rig: {mounting: {forward: 1, sideways: 1}}", "t");
+  std::set<std::string> lenses, events, motions, mountings;
+  for (int run = 0; run < 300; ++run) {
+    const CampaignRunSpec spec = drawCampaignRun(ranges, run, 100 + run, 600, true);
+    const MeasurementScenario& s = spec.scenario;
+    ASSERT_TRUE(s.validate().empty()) << run;
+    EXPECT_EQ(s.seed, 100u + run);
+    const double baseline = -s.truth(7);
+    EXPECT_GE(baseline, 0.08);
+    EXPECT_LE(baseline, 0.6);
+    EXPECT_GE(s.left.width, 640);
+    EXPECT_LE(s.left.width, 1280);
+    EXPECT_EQ(s.left.height * 4, s.left.width * 3);
+    EXPECT_GE(s.left.fx, 400);
+    EXPECT_LE(s.left.fx, 1400);
+    if (s.left.model == DistortionModel::kPlumbBob) {
+      EXPECT_GE(s.left.distortion[0], -0.3);
+      EXPECT_LE(s.left.distortion[0], 0.0);
+    }
+    for (int i = 0; i < 3; ++i) EXPECT_LE(std::abs(s.initial_error(i)), 0.5);
+    for (int i = 3; i < 6; ++i) EXPECT_LE(std::abs(s.initial_error(i)), 10 * kDeg + 1e-12);
+    EXPECT_LE(std::abs(s.initial_error(7)), 0.5 * baseline + 1e-12);
+    for (int i : {6, 8}) EXPECT_LE(std::abs(s.initial_error(i)), 0.02);
+    for (int i = 9; i < 12; ++i) EXPECT_LE(std::abs(s.initial_error(i)), 5 * kDeg + 1e-12);
+    if (s.step_frame >= 0) {
+      EXPECT_GE(s.step_frame, 240);
+      EXPECT_LE(s.step_frame, 360);
+      const double size = s.step.norm() / kDeg;
+      EXPECT_GE(size, 0.1 - 1e-9);
+      EXPECT_LE(size, 10 + 1e-9);
+    }
+    EXPECT_LE(s.drift_per_second.segment<3>(9).norm(), 0.5 * kDeg / 60 + 1e-15);
+    EXPECT_LE(s.drift_per_second.segment<3>(6).norm(), 0.005 / 60 + 1e-15);
+    EXPECT_LE(std::abs(s.odometry_error.time_offset), 0.030);
+    EXPECT_LE(std::abs(s.odometry_error.scale_error), 0.02);
+    EXPECT_LE(s.odometry_error.rotation_rate_bias, 0.01 * kDeg);
+    EXPECT_LE(s.odometry_error.velocity_bias, 0.02);
+    EXPECT_LE(s.blind_frames.size(), 1u);
+    for (const FrameSpan& b : s.blind_frames) {
+      EXPECT_GE(b.last - b.first + 1, 20);
+      EXPECT_LE(b.last - b.first + 1, 50);
+      EXPECT_GE(b.first, 30);
+    }
+    if (s.motion.planar) {
+      EXPECT_GE(s.motion.speed, 8);
+      EXPECT_LE(s.motion.speed, 15);
+      EXPECT_GE(s.motion.stops.size(), 1u);
+      EXPECT_LE(s.motion.stops.size(), 2u);
+      for (const TimeSpan& stop : s.motion.stops) {
+        EXPECT_GE(stop.duration, 2);
+        EXPECT_LE(stop.duration, 10);
+        EXPECT_GE(stop.start, 0);
+        EXPECT_LE(stop.start + stop.duration + s.motion.stop_ramp, 60.0);
+      }
+    } else {
+      EXPECT_GE(s.motion.speed, 2);
+      EXPECT_LE(s.motion.speed, 6);
+    }
+    EXPECT_LE(s.moving_point_fraction, 0.2);
+    EXPECT_LE(spec.image_options.render.noise_sigma, 3);
+    EXPECT_LE(spec.image_options.render.blur_sigma, 1);
+    EXPECT_LE(spec.image_options.exposure_variation, 0.2);
+    // The settings are the documented columns, in order.
+    const std::vector<std::string> names = campaignSettingNames(true);
+    ASSERT_EQ(spec.settings.size(), names.size());
+    for (size_t i = 0; i < names.size(); ++i) EXPECT_EQ(spec.settings[i].first, names[i]);
+    lenses.insert(spec.settings[4].second);
+    mountings.insert(spec.settings[6].second);
+    motions.insert(spec.settings[8].second);
+    events.insert(spec.settings[22].second);
+  }
+  EXPECT_EQ(lenses, (std::set<std::string>{"pinhole", "plumb_bob", "equidistant"}));
+  EXPECT_EQ(mountings, (std::set<std::string>{"forward", "sideways_left", "sideways_right"}));
+  EXPECT_EQ(motions, (std::set<std::string>{"offroad", "urban"}));
+  EXPECT_EQ(events, (std::set<std::string>{"none", "caml_yaw_step", "camr_knock", "camr_drift"}));
+
+  // The same seed gives the same run; another seed another one.
+  const CampaignRunSpec a = drawCampaignRun(ranges, 3, 7, 600, false);
+  const CampaignRunSpec b = drawCampaignRun(ranges, 3, 7, 600, false);
+  const CampaignRunSpec c = drawCampaignRun(ranges, 3, 8, 600, false);
+  EXPECT_EQ(a.settings, b.settings);
+  EXPECT_EQ(a.scenario.truth, b.scenario.truth);
+  EXPECT_EQ(a.scenario.initial_error, b.scenario.initial_error);
+  EXPECT_NE(a.scenario.initial_error, c.scenario.initial_error);
+}
+
+TEST(CampaignDraw, RecordedTrajectoryStretchLiesInTheFile) {
+  TempDir dir;
+  {
+    std::ofstream tum(dir.path() + "/line.tum");
+    for (int i = 0; i <= 1000; ++i) tum << 100.0 + 0.1 * i << " " << 0.5 * i << " 0 0 0 0 0 1\n";
+  }
+  const CampaignRanges ranges =
+      parseCampaignRanges("trajectories_dir: " + dir.path() + "\nmotion: {kind: recorded}", "t");
+  for (int run = 0; run < 20; ++run) {
+    const CampaignRunSpec spec = drawCampaignRun(ranges, run, run, 300, false);
+    EXPECT_TRUE(spec.error.empty()) << spec.error;
+    ASSERT_TRUE(spec.scenario.recorded_trajectory);
+    EXPECT_DOUBLE_EQ(spec.scenario.recorded_trajectory->firstStamp(), 100.0);
+    EXPECT_GE(spec.scenario.recorded_start_offset, 0.0);
+    EXPECT_LE(spec.scenario.recorded_start_offset + 30.0, 100.0);
+    EXPECT_EQ(spec.settings[9].second, "line");
+  }
+  // A drive longer than the recording: the run cannot be made, the error names the file, the
+  // settings are all there.
+  const CampaignRunSpec too_long = drawCampaignRun(ranges, 0, 0, 2000, false);
+  EXPECT_NE(too_long.error.find("line.tum"), std::string::npos) << too_long.error;
+  EXPECT_EQ(too_long.settings.size(), campaignSettingNames(false).size());
+}
+
+ScenarioFrameResult frameWithErrors(int index, const Vector12d& z) {
+  ScenarioFrameResult f;
+  f.frame = index;
+  f.truth.setZero();
+  f.truth(5) = M_PI - 0.001;  // the yaw error must be wrapped
+  f.sigmas = Vector12d::Constant(0.01);
+  f.parameters = f.truth + z * 0.01;
+  f.parameters(5) -= 2 * M_PI;
+  f.nees = 24.0;
+  f.time_ms = index;
+  return f;
+}
+
+TEST(CampaignScore, CountsFramesAgainstTheSigmasFromFrame30) {
+  std::vector<ScenarioFrameResult> frames;
+  for (int k = 0; k < 100; ++k) {
+    Vector12d z = Vector12d::Constant(1.0);
+    if (k < 30) z(0) = 100.0;   // not scored
+    if (k == 40) z(5) = -4.0;   // beyond 3 sigma only
+    if (k == 50) z(10) = 6.0;   // beyond 5 sigma
+    if (k == 60) z(10) = -7.5;  // the largest
+    frames.push_back(frameWithErrors(k, z));
+    frames.back().converged = k >= 45;
+  }
+  const CampaignScore s = scoreCampaignRun(frames);
+  EXPECT_DOUBLE_EQ(s.share_within_3sigma, 67.0 / 70.0);
+  EXPECT_EQ(s.frames_beyond_5sigma, 2);
+  EXPECT_EQ(s.first_frame_beyond_5sigma, 50);
+  EXPECT_NEAR(s.max_z, 7.5, 1e-6);
+  EXPECT_EQ(s.max_z_parameter, "pitch_r");
+  EXPECT_DOUBLE_EQ(s.nees_mean, 2.0);
+  EXPECT_EQ(s.converged_frame, 45);
+  EXPECT_DOUBLE_EQ(s.time_ms_median, 50.0);
+  // All 100 frames are within the last 150: xl has error 1 in frames 0-29, 0.01 after.
+  EXPECT_NEAR(s.rmse[0], std::sqrt((30 * 1.0 + 70 * 1e-4) / 100), 1e-12);
+  // yaw_l's errors, wrapped: 0.01 except -0.04 in frame 40.
+  EXPECT_NEAR(s.rmse[5], std::sqrt((99 * 1e-4 + 16e-4) / 100), 1e-9);
+}
+
+TEST(CampaignScore, NanEstimateIsBeyondEveryBound) {
+  std::vector<ScenarioFrameResult> frames;
+  for (int k = 0; k < 40; ++k) frames.push_back(frameWithErrors(k, Vector12d::Zero()));
+  frames[35].parameters(2) = NAN;
+  const CampaignScore s = scoreCampaignRun(frames);
+  EXPECT_EQ(s.frames_beyond_5sigma, 1);
+  EXPECT_EQ(s.first_frame_beyond_5sigma, 35);
+  EXPECT_TRUE(std::isinf(s.max_z));
+  EXPECT_EQ(s.max_z_parameter, "zl");
+  EXPECT_THROW(
+      scoreCampaignRun(std::vector<ScenarioFrameResult>(frames.begin(), frames.begin() + 30)),
+      std::invalid_argument);
+}
+
+TEST(CampaignCsv, RowsRoundTripAndFailedRowsKeepTheirColumns) {
+  const CampaignRanges ranges = parseCampaignRanges(kNoRecorded, "t");
+  const std::vector<std::string> names = campaignSettingNames(false);
+  CampaignRow row;
+  row.run = 4;
+  row.seed = 11;
+  row.frames = 100;
+  row.score.share_within_3sigma = 0.875;
+  row.score.frames_beyond_5sigma = 3;
+  row.score.max_z = 6.25;
+  row.score.max_z_parameter = "yaw_r";
+  row.score.first_frame_beyond_5sigma = 44;
+  row.score.nees_mean = 1.5;
+  row.score.converged_frame = -1;
+  row.score.time_ms_median = 0.75;
+  for (int p = 0; p < 12; ++p) row.score.rmse[p] = 0.001 * (p + 1);
+  row.settings = drawCampaignRun(ranges, 4, 11, 100, false).settings;
+  row.run_seconds = 1.25;
+  const CampaignRow failed = failedCampaignRow(5, 12, 100, {}, "boom, twice\nagain");
+  const std::string text = campaignCsvHeader(names) + "\n" + formatCampaignCsvLine(row, names) +
+                           "\n" + formatCampaignCsvLine(failed, names) + "\n";
+  const std::vector<CampaignRow> back = parseCampaignCsv(text, "t.csv");
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[0].run, 4);
+  EXPECT_EQ(back[0].seed, 11u);
+  EXPECT_EQ(back[0].score.share_within_3sigma, 0.875);
+  EXPECT_EQ(back[0].score.frames_beyond_5sigma, 3);
+  EXPECT_EQ(back[0].score.max_z_parameter, "yaw_r");
+  EXPECT_EQ(back[0].score.first_frame_beyond_5sigma, 44);
+  EXPECT_EQ(back[0].score.rmse[11], 0.012);
+  EXPECT_EQ(back[0].settings, row.settings);
+  EXPECT_TRUE(back[0].ok());
+  EXPECT_FALSE(back[0].honest());
+  EXPECT_FALSE(back[1].ok());
+  EXPECT_EQ(back[1].status, "failed: boom; twice again");
+  EXPECT_TRUE(std::isnan(back[1].score.share_within_3sigma));
+  EXPECT_EQ(back[1].settings.size(), names.size());
+  EXPECT_THROW(parseCampaignCsv("run,seed\n1,2\n", "bad.csv"), std::runtime_error);
+}
+
+TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
+  std::vector<CampaignRow> rows;
+  const std::vector<std::pair<std::string, std::string>> values = {
+      {"0", "a"}, {"1", "b"}, {"2", "a"}, {"3", "-"}, {"6", "a"}};
+  for (size_t i = 0; i < values.size(); ++i) {
+    CampaignRow row;
+    row.run = static_cast<int>(i);
+    row.settings = {{"x", values[i].first}, {"kind", values[i].second}};
+    row.score.share_within_3sigma = i == 1 ? 0.5 : 1.0;  // run 1 is not honest
+    row.score.max_z = static_cast<double>(i);
+    rows.push_back(row);
+  }
+  const std::vector<CampaignBucket> x = campaignBuckets(rows, "x");
+  ASSERT_EQ(x.size(), 3u);
+  EXPECT_EQ(x[0].label, "[0, 2)");
+  EXPECT_EQ(x[0].rows, (std::vector<int>{0, 1}));
+  EXPECT_EQ(x[1].rows, (std::vector<int>{2, 3}));
+  EXPECT_EQ(x[2].label, "[4, 6]");
+  EXPECT_EQ(x[2].rows, (std::vector<int>{4}));
+  const std::vector<CampaignBucket> kind = campaignBuckets(rows, "kind");
+  ASSERT_EQ(kind.size(), 3u);
+  EXPECT_EQ(kind[0].label, "-");
+  EXPECT_EQ(kind[1].label, "a");
+  EXPECT_EQ(kind[1].rows, (std::vector<int>{0, 2, 4}));
+  const std::string summary = formatCampaignSummary(rows, 1);
+  EXPECT_NE(
+      summary.find("Honest (share_within_3sigma >= 0.95 and frames_beyond_5sigma = 0): 4 of 5"),
+      std::string::npos)
+      << summary;
+  // The worst run listed first is the one that is not honest, though run 4 has a larger max_z.
+  EXPECT_NE(summary.find("run 1  seed 0  NOT honest"), std::string::npos) << summary;
+  EXPECT_EQ(summary.find("run 4  seed"), std::string::npos) << summary;
+}
+
+}  // namespace
+}  // namespace osc
+
+namespace osc {
+namespace {
+
+/// The documented columns, in order (issue 13), then rmse_<p>, the settings, run_s, status.
+TEST(Campaign, FourRunsOf100FramesWriteTheDocumentedColumnsAndResume) {
+  TempDir dir;
+  const CampaignInputs inputs = inputsFor(kNoRecorded, 100, 40);
+  const std::vector<CampaignRow> rows = runCampaign(inputs, quietOptions(dir.path(), 4, 2));
+  ASSERT_EQ(rows.size(), 4u);
+  std::ifstream csv(dir.path() + "/campaign.csv");
+  std::string header;
+  std::getline(csv, header);
+  std::vector<std::string> expected = {"run",
+                                       "seed",
+                                       "frames",
+                                       "share_within_3sigma",
+                                       "frames_beyond_5sigma",
+                                       "max_z",
+                                       "max_z_parameter",
+                                       "first_frame_beyond_5sigma",
+                                       "nees_mean",
+                                       "converged_frame",
+                                       "time_ms_median"};
+  for (const char* p : {"xl", "yl", "zl", "roll_l", "pitch_l", "yaw_l", "xr", "yr", "zr", "roll_r",
+                        "pitch_r", "yaw_r"}) {
+    expected.push_back(std::string("rmse_") + p);
+  }
+  for (const std::string& name : campaignSettingNames(false)) expected.push_back(name);
+  expected.push_back("run_s");
+  expected.push_back("status");
+  std::string joined;
+  for (const std::string& c : expected) joined += (joined.empty() ? "" : ",") + c;
+  EXPECT_EQ(header, joined);
+  int lines = 0;
+  for (std::string line; std::getline(csv, line);) ++lines;
+  EXPECT_EQ(lines, 4);
+  const std::vector<CampaignRow> read = readCampaignCsv(dir.path() + "/campaign.csv");
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(read[k].run, k);
+    EXPECT_EQ(read[k].seed, 40u + k);
+    EXPECT_EQ(read[k].frames, 100);
+    EXPECT_TRUE(read[k].ok()) << read[k].status;
+    EXPECT_GE(read[k].score.share_within_3sigma, 0.0);
+    EXPECT_LE(read[k].score.share_within_3sigma, 1.0);
+    EXPECT_GT(read[k].score.time_ms_median, 0.0);
+  }
+  const std::string summary = readTextFile(dir.path() + "/summary.txt");
+  EXPECT_NE(summary.find("Campaign of 4 runs"), std::string::npos);
+  EXPECT_NE(summary.find("baseline_m"), std::string::npos);
+
+  // Resuming runs nothing again: the rows (with their wall times) stay as they were.
+  const std::vector<CampaignRow> again = runCampaign(inputs, quietOptions(dir.path(), 4, 2));
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(again[k].run_seconds, rows[k].run_seconds);
+  // Other inputs are refused, naming what differs.
+  try {
+    runCampaign(inputsFor(kNoRecorded, 120, 40), quietOptions(dir.path(), 4, 2));
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("--frames"), std::string::npos) << e.what();
+  }
+  try {
+    runCampaign(inputsFor(std::string(kNoRecorded) + "events: {kind: none}\n", 100, 40),
+                quietOptions(dir.path(), 4, 2));
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("the ranges"), std::string::npos) << e.what();
+  }
+}
+
+// --only K gives the campaign's row of run K, with the per-frame files of evaluate.
+TEST(Campaign, ReplayOfARunGivesItsRowAndPerFrameFiles) {
+  TempDir dir;
+  const CampaignInputs inputs = inputsFor(kNoRecorded, 100, 20);
+  const std::vector<CampaignRow> rows = runCampaign(inputs, quietOptions(dir.path(), 2, 2));
+  const CampaignRow replayed = replayCampaignRun(inputs, dir.path(), 1, false);
+  EXPECT_EQ(replayed.seed, 21u);
+  EXPECT_EQ(replayed.settings, rows[1].settings);
+  // The campaign's rows come from its CSV (10 significant digits).
+  EXPECT_NEAR(replayed.score.share_within_3sigma, rows[1].score.share_within_3sigma, 1e-9);
+  EXPECT_NEAR(replayed.score.max_z, rows[1].score.max_z, 1e-8 * rows[1].score.max_z);
+  EXPECT_EQ(replayed.score.frames_beyond_5sigma, rows[1].score.frames_beyond_5sigma);
+  for (int p = 0; p < 12; ++p) {
+    EXPECT_NEAR(replayed.score.rmse[p], rows[1].score.rmse[p], 1e-8 * rows[1].score.rmse[p]);
+  }
+  const std::string run_dir = dir.path() + "/run_1";
+  const std::vector<EstimateRow> estimates = readEstimatesCsv(run_dir + "/estimates.csv");
+  const std::vector<ReferenceRow> reference = readReferenceCsv(run_dir + "/reference.csv");
+  ASSERT_EQ(estimates.size(), 100u);
+  ASSERT_EQ(reference.size(), 100u);
+  // The RMSE of xl over the last 150 (here all 100) frames, from the files.
+  double sum = 0.0;
+  for (size_t i = 0; i < estimates.size(); ++i) {
+    const double e = estimates[i].parameters(0) - reference[i].parameters(0);
+    sum += e * e;
+  }
+  EXPECT_NEAR(std::sqrt(sum / 100.0), replayed.score.rmse[0], 1e-12);
+  EXPECT_EQ(readCampaignCsv(run_dir + "/run.csv").size(), 1u);
+  EXPECT_NE(readTextFile(run_dir + "/settings.txt").find("seed 21"), std::string::npos);
+  // A replay with other inputs is refused.
+  EXPECT_THROW(replayCampaignRun(inputsFor(kNoRecorded, 100, 21), dir.path(), 1, false),
+               std::runtime_error);
+}
+
+TEST(Campaign, SameSeedGivesTheSameRows) {
+  TempDir one, two;
+  const CampaignInputs inputs = inputsFor(kNoRecorded, 100, 7);
+  const std::vector<CampaignRow> a = runCampaign(inputs, quietOptions(one.path(), 2, 2));
+  const std::vector<CampaignRow> b = runCampaign(inputs, quietOptions(two.path(), 2, 1));
+  ASSERT_EQ(a.size(), 2u);
+  ASSERT_EQ(b.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(a[k].seed, b[k].seed);
+    EXPECT_EQ(a[k].settings, b[k].settings);
+    EXPECT_EQ(a[k].score.share_within_3sigma, b[k].score.share_within_3sigma);
+    EXPECT_EQ(a[k].score.max_z, b[k].score.max_z);
+    EXPECT_EQ(a[k].score.nees_mean, b[k].score.nees_mean);
+    EXPECT_EQ(a[k].score.rmse, b[k].score.rmse);
+    EXPECT_EQ(a[k].score.converged_frame, b[k].score.converged_frame);
+  }
+  EXPECT_NE(a[0].score.rmse, a[1].score.rmse);
+}
+
+// A run that cannot be made (here: the recording is shorter than the drive) is a failed row;
+// the campaign goes on and the summary counts it.
+TEST(Campaign, FailedRunsAreRecordedNotFatal) {
+  TempDir tum_dir, dir;
+  {
+    std::ofstream tum(tum_dir.path() + "/short.tum");
+    for (int i = 0; i <= 50; ++i) tum << 0.1 * i << " " << 0.5 * i << " 0 0 0 0 0 1\n";
+  }
+  const std::string ranges =
+      "trajectories_dir: " + tum_dir.path() + "\nmotion: {kind: {offroad: 1, recorded: 1}}\n";
+  const std::vector<CampaignRow> rows =
+      runCampaign(inputsFor(ranges, 100, 3), quietOptions(dir.path(), 6, 2));
+  ASSERT_EQ(rows.size(), 6u);
+  int failed = 0;
+  for (const CampaignRow& row : rows) {
+    const bool recorded = !row.settings.empty() && row.settings[8].second == "recorded";
+    EXPECT_EQ(row.ok(), !recorded) << row.status;
+    if (row.ok()) continue;
+    ++failed;
+    EXPECT_NE(row.status.find("shorter than the drive"), std::string::npos) << row.status;
+    EXPECT_TRUE(std::isnan(row.score.share_within_3sigma));
+    EXPECT_FALSE(row.honest());
+  }
+  EXPECT_GT(failed, 0);
+  EXPECT_LT(failed, 6);
+  EXPECT_NE(
+      readTextFile(dir.path() + "/summary.txt")
+          .find("(" + std::to_string(6 - failed) + " ran, " + std::to_string(failed) + " failed)"),
+      std::string::npos);
+}
+
+// The shipped configuration against one that declares the pixel noise 10x too small (the
+// simulator adds 0.5 px). On the easy ranges the shipped filter is honest in 3 of the 4 runs
+// (run 3: yr beyond 3 sigma in 44 % of the frames, max_z 4.8; a campaign is a measurement,
+// and this is one of its findings): the test asserts that majority and that no run is grossly
+// overconfident, against every overconfident run being far beyond its sigmas.
+TEST(Campaign, OverconfidentConfigurationIsNotHonestTheShippedOneIs) {
+  TempDir shipped_dir, overconfident_dir;
+  const CampaignInputs shipped = inputsFor(kEasy, 100, 1);
+  const std::vector<CampaignRow> good =
+      runCampaign(shipped, quietOptions(shipped_dir.path(), 4, 2));
+  CampaignInputs overconfident = shipped;
+  overconfident.config.filter.pixel_noise = shipped.config.filter.pixel_noise / 10.0;
+  const std::vector<CampaignRow> bad =
+      runCampaign(overconfident, quietOptions(overconfident_dir.path(), 4, 2));
+  int honest = 0;
+  for (const CampaignRow& row : good) {
+    honest += row.honest();
+    EXPECT_LT(row.score.max_z, 6.0) << "run " << row.run;
+    EXPECT_LT(row.score.nees_mean, 3.0) << "run " << row.run;
+  }
+  EXPECT_GE(honest, 3);
+  for (const CampaignRow& row : bad) {
+    EXPECT_FALSE(row.honest()) << "run " << row.run << ": share " << row.score.share_within_3sigma;
+    EXPECT_GT(row.score.max_z, 10.0) << "run " << row.run;
+    EXPECT_GT(row.score.nees_mean, 10.0) << "run " << row.run;
+  }
+  const std::string summary = readTextFile(overconfident_dir.path() + "/summary.txt");
+  EXPECT_NE(summary.find("frames_beyond_5sigma = 0): 0 of 4 (0 %)"), std::string::npos) << summary;
+}
+
+}  // namespace
+}  // namespace osc
