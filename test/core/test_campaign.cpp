@@ -9,6 +9,7 @@
 #include <set>
 #include <string>
 
+#include "online_stereo_calibration/core/geometry/pose_interpolation.h"
 #include "online_stereo_calibration/tools/campaign.h"
 #include "online_stereo_calibration/tools/campaign_csv.h"
 #include "online_stereo_calibration/tools/campaign_draw.h"
@@ -16,7 +17,7 @@
 #include "online_stereo_calibration/tools/campaign_score.h"
 #include "online_stereo_calibration/tools/campaign_summary.h"
 #include "online_stereo_calibration/tools/estimates_csv.h"
-#include "online_stereo_calibration/tools/pose_interpolation.h"
+#include "online_stereo_calibration/tools/tum_trajectory.h"
 
 namespace osc {
 namespace {

@@ -8,7 +8,8 @@
 #include <random>
 #include <stdexcept>
 
-#include "online_stereo_calibration/tools/pose_interpolation.h"
+#include "online_stereo_calibration/core/geometry/pose_interpolation.h"
+#include "online_stereo_calibration/tools/tum_trajectory.h"
 
 namespace osc {
 
