@@ -10,6 +10,7 @@
 
 #include "online_stereo_calibration/core/geometry/pose.h"
 #include "online_stereo_calibration/core/geometry/stereo_rectification.h"
+#include "online_stereo_calibration/core/pipeline/live_rectification.h"
 #include "online_stereo_calibration/core/sim/stereo_scene_renderer.h"
 
 namespace osc {
@@ -225,6 +226,51 @@ TEST(DepthSigma, FirstOrderMatchesAMonteCarloOfTheCovariance) {
   // Grows with the square of the distance (the yaw term dominates).
   EXPECT_GT(depthSigmaOnAxis(rig, covariance, 50.0),
             20.0 * depthSigmaOnAxis(rig, covariance, 10.0));
+}
+
+// R and P follow the estimate only when it moved the rectified images by more than the
+// threshold, or the cameras changed.
+TEST(LiveRectification, RecomputesOnlyWhenTheEstimateMovedEnough) {
+  const double update_px = 0.2;
+  LiveRectification live(RectificationSettings(), update_px);
+  EXPECT_FALSE(live.rectification());
+  StereoExtrinsics rig = trueRig();
+  EXPECT_TRUE(live.update(euroc(false), euroc(true), rig));
+  ASSERT_TRUE(live.rectification());
+  const double focal = live.rectification()->P_left(0, 0);
+  // A yaw of 0.1 px: kept. Another 0.15 px on top (0.25 px from the published one): redone.
+  Vector12d p = rig.toParameters();
+  p(11) += 0.1 / focal;
+  EXPECT_FALSE(live.update(euroc(false), euroc(true), StereoExtrinsics::fromParameters(p)));
+  p(11) += 0.15 / focal;
+  EXPECT_TRUE(live.update(euroc(false), euroc(true), StereoExtrinsics::fromParameters(p)));
+  EXPECT_LT((live.rectification()->T_lopt_ropt.linear() -
+             StereoExtrinsics::fromParameters(p).leftToRightOptical().linear())
+                .norm(),
+            1e-12);
+  CameraIntrinsics other = euroc(true);
+  other.cx += 1.0;
+  EXPECT_TRUE(live.update(euroc(false), other, StereoExtrinsics::fromParameters(p)));
+  EXPECT_THROW(LiveRectification(RectificationSettings(), -1.0), std::invalid_argument);
+  RectificationSettings bad;
+  bad.alpha = 2.0;
+  EXPECT_THROW(LiveRectification(bad, 0.1), std::invalid_argument);
+}
+
+// The quality figures of an estimate: the renderer's pairs and the covariance as above.
+TEST(LiveRectification, QualityOfAnEstimate) {
+  const StereoExtrinsics truth = trueRig();
+  const std::vector<StereoObservation> pairs = renderedTruePairs(truth);
+  const LiveRectification live(RectificationSettings(), 0.1);
+  CalibrationEstimate estimate;
+  estimate.extrinsics = truth;
+  estimate.tangent_covariance = camrCovariance(1e-3, 0.01 * kDeg, 0.3);
+  const CalibrationQuality q = live.quality(euroc(false), euroc(true), pairs, estimate);
+  ASSERT_TRUE(q.rectification_error);
+  EXPECT_LT(q.rectification_error->median_px, 1e-6);
+  EXPECT_EQ(q.depth_sigma_10m, depthSigmaOnAxis(truth, estimate.tangent_covariance, 10.0));
+  EXPECT_EQ(q.depth_sigma_50m, depthSigmaOnAxis(truth, estimate.tangent_covariance, 50.0));
+  EXPECT_FALSE(live.quality(euroc(false), euroc(true), {}, estimate).rectification_error);
 }
 
 }  // namespace
