@@ -129,4 +129,15 @@ Eigen::Isometry3d interpolatePose(const StampedPose& before, const StampedPose& 
   return result;
 }
 
+sensor_msgs::CameraInfo rectifiedCameraInfo(const sensor_msgs::CameraInfo& input,
+                                            const Eigen::Matrix3d& R,
+                                            const Eigen::Matrix<double, 3, 4>& P) {
+  sensor_msgs::CameraInfo info = input;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) info.R[3 * i + j] = R(i, j);
+    for (int j = 0; j < 4; ++j) info.P[4 * i + j] = P(i, j);
+  }
+  return info;
+}
+
 }  // namespace online_stereo_calibration
