@@ -534,10 +534,13 @@ void CalibrationNodelet::publishRectification(const StereoPair& pair,
     NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: rectification: %s", e.what());
   }
   if (!rectification_->rectification()) return;
-  // Stamped and framed like the input images (their camera_info may differ in frame_id).
+  // Stamped like the input images and both framed like the left one: R and P put both
+  // cameras into the left rectified frame, and image_geometry's StereoCameraModel (used by
+  // stereo_image_proc) requires one frame for the pair (Debian's build asserts on it).
   sensor_msgs::CameraInfo left_info = *pair.left_info, right_info = *pair.right_info;
   left_info.header = pair.left->header;
   right_info.header = pair.right->header;
+  right_info.header.frame_id = pair.left->header.frame_id;
   output_->publishRectifiedCameraInfo(left_info, right_info, *rectification_->rectification());
 }
 

@@ -23,7 +23,8 @@ osc::CameraIntrinsics intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& in
 
 /// The CameraInfo of the rectification that follows the calibration: the input's header,
 /// size, binning, ROI, distortion model, K and D, with @p R (raw optical -> rectified) and
-/// @p P (rectified projection, px) of osc::StereoRectification.
+/// @p P (rectified projection, px) of osc::StereoRectification. A D that is all zero (or
+/// empty) gets k1 = 1e-12: image_geometry leaves such an image unrectified whatever R says.
 sensor_msgs::CameraInfo rectifiedCameraInfo(const sensor_msgs::CameraInfo& input,
                                             const Eigen::Matrix3d& R,
                                             const Eigen::Matrix<double, 3, 4>& P);
