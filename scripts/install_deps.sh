@@ -28,6 +28,7 @@ debian_ros=(
   libcv-bridge-dev libmessage-filters-dev libimage-transport-dev libdiagnostic-updater-dev
   librosbag-dev librostest-dev python3-rosbag python3-rostest rosbash
   libstd-srvs-dev libnav-msgs-dev libvisualization-msgs-dev
+  ros-stereo-image-proc libstereo-image-proc-dev libstereo-msgs-dev
   rviz
 )
 
@@ -40,6 +41,7 @@ noetic_ros=(
   ros-noetic-rosbash
   ros-noetic-sensor-msgs ros-noetic-geometry-msgs ros-noetic-nav-msgs ros-noetic-std-srvs
   ros-noetic-visualization-msgs ros-noetic-diagnostic-msgs
+  ros-noetic-stereo-image-proc ros-noetic-stereo-msgs
   ros-noetic-rviz
 )
 

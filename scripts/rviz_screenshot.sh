@@ -7,6 +7,9 @@
 #
 #   bash scripts/rviz_screenshot.sh [OUT.png]     (default docs/rviz_screenshot.png)
 #
+# OSC_SHOT_RECTIFY=1 adds stereo_image_proc on the live calibration (rectify:=true) and so the
+# stereo point cloud (docs/rviz_point_cloud.png:
+#   OSC_SHOT_RECTIFY=1 bash scripts/rviz_screenshot.sh docs/rviz_point_cloud.png).
 # Environment: OSC_BUILD_DIR (default build), OSC_SHOT_FRAMES (frames rendered, default 150,
 # played at half speed: 30 s), OSC_SHOT_AFTER (s after the start before the grab, default 30;
 # keep it below 3 + 2 * FRAMES / 10: the launch ends with the bag), DISPLAY_NUMBER (default 99).
@@ -18,6 +21,8 @@ BUILD="${OSC_BUILD_DIR:-build}"
 FRAMES="${OSC_SHOT_FRAMES:-150}"
 AFTER="${OSC_SHOT_AFTER:-30}"
 DISPLAY_NUMBER="${DISPLAY_NUMBER:-99}"
+RECTIFY=false
+[[ "${OSC_SHOT_RECTIFY:-0}" == "1" ]] && RECTIFY=true
 WORK="${TMPDIR:-/tmp}/osc_rviz_screenshot"
 export PATH="/usr/bin:$PATH"  # ROS's python tools need the system python3
 
@@ -56,7 +61,7 @@ sleep 2
 export ROS_MASTER_URI="http://localhost:11399"
 export ROS_HOME="$WORK/ros_home"
 roslaunch -p 11399 online_stereo_calibration play_bag.launch bag:="$WORK/drive/drive.bag" \
-  rate:=0.5 ros_config:="$WORK/ros.yaml" rviz:=true >"$WORK/roslaunch.log" 2>&1 &
+  rate:=0.5 ros_config:="$WORK/ros.yaml" rviz:=true rectify:="$RECTIFY" >"$WORK/roslaunch.log" 2>&1 &
 PIDS+=($!)
 sleep "$AFTER"
 import -window root "$WORK/screen.png"

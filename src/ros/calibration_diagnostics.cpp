@@ -111,10 +111,16 @@ void CalibrationDiagnostics::recordEstimate(const osc::CalibrationEstimate& esti
   have_estimate_ = true;
 }
 
+void CalibrationDiagnostics::recordQuality(const osc::CalibrationQuality& quality) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  quality_ = quality;
+}
+
 void CalibrationDiagnostics::recordReset() {
   std::lock_guard<std::mutex> lock(mutex_);
   ++resets_;
   have_estimate_ = false;
+  quality_.reset();
 }
 
 void CalibrationDiagnostics::update() {
@@ -213,6 +219,16 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
       level = DiagnosticStatus::ERROR;
       reasons.push_back("non-finite estimate");
     }
+  }
+  // Quality figures of the last processed pair (issue 16): values only, no level.
+  if (have_estimate_ && quality_) {
+    const auto& error = quality_->rectification_error;
+    status.add("rectification error [px]", error
+                                               ? std::to_string(error->median_px) + " (median of " +
+                                                     std::to_string(error->pairs) + " pairs)"
+                                               : std::string("no stereo pair"));
+    status.add("depth sigma at 10 m [m]", quality_->depth_sigma_10m);
+    status.add("depth sigma at 50 m [m]", quality_->depth_sigma_50m);
   }
   // Problems since the last report make the status WARN; totals are always listed.
   counts_at_last_report_.resize(problems_.size());

@@ -87,6 +87,12 @@ void CalibrationNodelet::onInit() {
   };
   diagnostics_->setInitialGuess(initial_guess_description_);
   output_ = std::make_unique<OutputPublisher>(nh, pnh, config_.ros.publish_tf);
+  osc::RectificationSettings rectification;
+  rectification.alpha = config_.ros.rectification_alpha;
+  rectification.width = config_.ros.rectification_width;
+  rectification.height = config_.ros.rectification_height;
+  rectification_ =
+      std::make_unique<osc::LiveRectification>(rectification, config_.ros.rectification_update_px);
 
   reset_srv_ = pnh.advertiseService("reset", &CalibrationNodelet::resetService, this);
   save_srv_ = pnh.advertiseService("save_calibration", &CalibrationNodelet::saveService, this);
@@ -431,14 +437,28 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
       result.estimator.step.jump != osc::JumpBlock::kNone || result.right_camera_reopened;
   const uint8_t state = calibrationState(result.estimate, jump, config_.ros.min_tracked_points,
                                          config_.ros.converged);
-  const StereoCalibration message =
+  StereoCalibration message =
       makeCalibrationMessage(result.estimate, stamp, frames_, state, result.processing_time);
+  osc::CalibrationQuality quality;
+  bool have_quality = false;
+  if (result.estimate.parameters.allFinite() && result.estimate.tangent_covariance.allFinite()) {
+    try {
+      quality = rectification_->quality(left_intrinsics_, right_intrinsics_, result.stereo_pairs,
+                                        result.estimate);
+      have_quality = true;
+    } catch (const std::exception& e) {
+      diagnostics_->recordProblem("processing errors", std::string("quality figures: ") + e.what());
+    }
+  }
+  setQualityFields(quality, &message);
   diagnostics_->recordEstimate(result.estimate, state);
+  if (have_quality) diagnostics_->recordQuality(quality);
   if (!output_->publishCalibration(message, result.estimate)) {
     diagnostics_->recordProblem("non-finite estimate", "estimate not published");
     NODELET_ERROR_THROTTLE(5.0, "online_stereo_calibration: non-finite estimate not published");
     return;
   }
+  if (config_.ros.publish_rectification) publishRectification(pair, result.estimate.extrinsics);
   {
     std::lock_guard<std::mutex> lock(pipeline_mutex_);
     last_estimate_ = result.estimate;
@@ -503,6 +523,25 @@ bool CalibrationNodelet::saveCalibration(std::string* error) {
     return false;
   }
   return true;
+}
+
+void CalibrationNodelet::publishRectification(const StereoPair& pair,
+                                              const osc::StereoExtrinsics& estimate) {
+  try {
+    rectification_->update(left_intrinsics_, right_intrinsics_, estimate);
+  } catch (const std::exception& e) {
+    diagnostics_->recordProblem("processing errors", std::string("rectification: ") + e.what());
+    NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: rectification: %s", e.what());
+  }
+  if (!rectification_->rectification()) return;
+  // Stamped like the input images and both framed like the left one: R and P put both
+  // cameras into the left rectified frame, and image_geometry's StereoCameraModel (used by
+  // stereo_image_proc) requires one frame for the pair (Debian's build asserts on it).
+  sensor_msgs::CameraInfo left_info = *pair.left_info, right_info = *pair.right_info;
+  left_info.header = pair.left->header;
+  right_info.header = pair.right->header;
+  right_info.header.frame_id = pair.left->header.frame_id;
+  output_->publishRectifiedCameraInfo(left_info, right_info, *rectification_->rectification());
 }
 
 }  // namespace online_stereo_calibration

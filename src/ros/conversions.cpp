@@ -129,4 +129,26 @@ Eigen::Isometry3d interpolatePose(const StampedPose& before, const StampedPose& 
   return result;
 }
 
+sensor_msgs::CameraInfo rectifiedCameraInfo(const sensor_msgs::CameraInfo& input,
+                                            const Eigen::Matrix3d& R,
+                                            const Eigen::Matrix<double, 3, 4>& P) {
+  sensor_msgs::CameraInfo info = input;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) info.R[3 * i + j] = R(i, j);
+    for (int j = 0; j < 4; ++j) info.P[4 * i + j] = P(i, j);
+  }
+  // image_geometry's PinholeCameraModel (image_proc/rectify, 1.16-1.17) copies the raw image
+  // unchanged when every D is zero, whatever R and P say: a lens without distortion would
+  // not be rectified at all. A k1 of 1e-12 moves no pixel by more than 1e-9 px and makes it
+  // rectify.
+  bool all_zero = true;
+  for (double d : info.D) all_zero = all_zero && d == 0.0;
+  if (all_zero) {
+    if (info.distortion_model.empty()) info.distortion_model = "plumb_bob";
+    if (info.D.empty()) info.D.assign(info.distortion_model == "equidistant" ? 4 : 5, 0.0);
+    info.D[0] = 1e-12;
+  }
+  return info;
+}
+
 }  // namespace online_stereo_calibration

@@ -48,6 +48,15 @@ StereoCalibration makeCalibrationMessage(const osc::CalibrationEstimate& estimat
   return message;
 }
 
+void setQualityFields(const osc::CalibrationQuality& quality, StereoCalibration* message) {
+  message->rectification_error =
+      quality.rectification_error ? quality.rectification_error->median_px : -1.0;
+  message->rectification_pairs =
+      quality.rectification_error ? static_cast<uint32_t>(quality.rectification_error->pairs) : 0;
+  message->depth_sigma_10m = quality.depth_sigma_10m;
+  message->depth_sigma_50m = quality.depth_sigma_50m;
+}
+
 sensor_msgs::PointCloud2 makePointCloud(const std::vector<osc::PointEstimate>& points,
                                         const std_msgs::Header& header) {
   sensor_msgs::PointCloud2 cloud;
@@ -155,6 +164,8 @@ OutputPublisher::OutputPublisher(ros::NodeHandle& /*nh*/, ros::NodeHandle& priva
   calibration_pub_ = private_nh.advertise<StereoCalibration>("calibration", 10);
   points_pub_ = private_nh.advertise<sensor_msgs::PointCloud2>("tracked_points", 2);
   markers_pub_ = private_nh.advertise<visualization_msgs::MarkerArray>("markers", 2);
+  left_info_pub_ = private_nh.advertise<sensor_msgs::CameraInfo>("left/camera_info", 10);
+  right_info_pub_ = private_nh.advertise<sensor_msgs::CameraInfo>("right/camera_info", 10);
   image_transport::ImageTransport it(private_nh);
   debug_pub_ = it.advertise("debug_image", 1);
 }
@@ -189,6 +200,15 @@ void OutputPublisher::publishPoints(const std::vector<osc::PointEstimate>& point
                                     const std_msgs::Header& header) {
   if (points_pub_.getNumSubscribers() == 0) return;
   points_pub_.publish(makePointCloud(points, header));
+}
+
+void OutputPublisher::publishRectifiedCameraInfo(const sensor_msgs::CameraInfo& left_input,
+                                                 const sensor_msgs::CameraInfo& right_input,
+                                                 const osc::StereoRectification& rectification) {
+  left_info_pub_.publish(
+      rectifiedCameraInfo(left_input, rectification.R_left, rectification.P_left));
+  right_info_pub_.publish(
+      rectifiedCameraInfo(right_input, rectification.R_right, rectification.P_right));
 }
 
 bool OutputPublisher::debugImageWanted() const { return debug_pub_.getNumSubscribers() > 0; }

@@ -200,6 +200,11 @@ RosConfig loadRosConfig(const ros::NodeHandle& nh, std::vector<std::string>* pro
   }
   readNumber(nh, "min_rate", &config.min_rate, problems);
   readNumber(nh, "max_rate", &config.max_rate, problems);
+  readBool(nh, "publish_rectification", &config.publish_rectification, problems);
+  readNumber(nh, "rectification_alpha", &config.rectification_alpha, problems);
+  readInt(nh, "rectification_width", &config.rectification_width, problems);
+  readInt(nh, "rectification_height", &config.rectification_height, problems);
+  readNumber(nh, "rectification_update_px", &config.rectification_update_px, problems);
   for (const std::string& problem : config.validate()) problems->push_back(problem);
   return config;
 }

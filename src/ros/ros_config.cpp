@@ -40,6 +40,17 @@ std::vector<std::string> RosConfig::validate() const {
   checkPositive("converged_3sigma_camr_rotation_deg", converged.camr_rotation, &problems);
   checkPositive("min_rate", min_rate, &problems);
   checkPositive("max_rate", max_rate, &problems);
+  if (!(rectification_alpha >= -1.0 && rectification_alpha <= 1.0)) {
+    problems.push_back("rectification_alpha = " + std::to_string(rectification_alpha) +
+                       ": must be in [-1, 1]");
+  }
+  if (rectification_width < 0 || rectification_height < 0) {
+    problems.push_back("rectification_width / rectification_height must be >= 0 (0 = input size)");
+  }
+  if ((rectification_width == 0) != (rectification_height == 0)) {
+    problems.push_back("rectification_width and rectification_height: set both or neither");
+  }
+  checkPositive("rectification_update_px", rectification_update_px, &problems, true);
   if (min_rate > max_rate) problems.push_back("min_rate must not exceed max_rate");
   if (min_tracked_points < 0) problems.push_back("min_tracked_points must be >= 0");
   if (motion_source == MotionSourceType::kTf && fixed_frame.empty()) {

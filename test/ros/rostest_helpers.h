@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -24,6 +25,7 @@
 
 #include "../../src/tools/ros/bag_io.h"
 #include "online_stereo_calibration/StereoCalibration.h"
+#include "online_stereo_calibration/core/geometry/stereo_rectification.h"
 #include "online_stereo_calibration/tools/drive_simulation.h"
 #include "online_stereo_calibration/tools/scenario_file.h"
 
@@ -329,16 +331,37 @@ class RenderedDrive {
   }
 
   sensor_msgs::CameraInfo leftInfo(const ros::Time& t) const {
-    return osc::bag::toCameraInfo(simulator_->scenario().measurement.left, t, names_.left_frame);
+    sensor_msgs::CameraInfo info =
+        osc::bag::toCameraInfo(simulator_->scenario().measurement.left, t, names_.left_frame);
+    if (factory_) {
+      info =
+          online_stereo_calibration::rectifiedCameraInfo(info, factory_->R_left, factory_->P_left);
+    }
+    return info;
   }
   sensor_msgs::CameraInfo rightInfo(const ros::Time& t) const {
-    return osc::bag::toCameraInfo(simulator_->scenario().measurement.right, t, names_.right_frame);
+    sensor_msgs::CameraInfo info =
+        osc::bag::toCameraInfo(simulator_->scenario().measurement.right, t, names_.right_frame);
+    if (factory_) {
+      info = online_stereo_calibration::rectifiedCameraInfo(info, factory_->R_right,
+                                                            factory_->P_right);
+      info.header.frame_id = names_.left_frame;  // one frame for a rectified pair
+    }
+    return info;
+  }
+  /// From now on the camera_info carries this rectification's R and P (as a stereo camera's
+  /// factory calibration does; rectifiedCameraInfo, so a pinhole D gets the k1 that makes
+  /// image_geometry rectify) instead of R = I, P = [K | 0], and the right camera_info the
+  /// left camera's frame (image_geometry's StereoCameraModel requires one frame).
+  void setFactoryRectification(const osc::StereoRectification& rectification) {
+    factory_ = rectification;
   }
 
   const osc::bag::DriveTopics& names() const { return names_; }
 
  private:
   osc::bag::DriveTopics names_;
+  std::optional<osc::StereoRectification> factory_;
   std::unique_ptr<osc::DriveSimulator> simulator_;
   std::vector<osc::StampedPose> odometry_;
   size_t next_odom_ = 0;

@@ -10,6 +10,7 @@
 #include "online_stereo_calibration/ros/conversions.h"
 #include "online_stereo_calibration/ros/motion_buffers.h"
 #include "online_stereo_calibration/ros/output_publisher.h"
+#include "online_stereo_calibration/ros/ros_config.h"
 
 namespace online_stereo_calibration {
 namespace {
@@ -179,6 +180,72 @@ TEST(CameraInfo, ConvertsKDAndModel) {
   uncalibrated.width = 640;
   uncalibrated.height = 480;
   EXPECT_THROW(intrinsicsFromCameraInfo(uncalibrated), std::invalid_argument);
+}
+
+// The rectified camera_info: the input's header, size, model, K and D with the given R and P;
+// an all-zero D gets the k1 that makes image_geometry rectify at all.
+TEST(CameraInfo, RectifiedKeepsTheInputAndSetsRAndP) {
+  sensor_msgs::CameraInfo input;
+  input.header.frame_id = "left_camera_optical";
+  input.header.stamp = ros::Time(12, 5);
+  input.width = 640;
+  input.height = 480;
+  input.K = {600.0, 0.0, 319.5, 0.0, 601.0, 239.5, 0.0, 0.0, 1.0};
+  input.distortion_model = "plumb_bob";
+  input.D = {-0.1, 0.01, 0.001, -0.002, 0.0};
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.01, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  Eigen::Matrix<double, 3, 4> P;
+  P << 610.0, 0.0, 320.0, -183.0, 0.0, 610.0, 240.0, 0.0, 0.0, 0.0, 1.0, 0.0;
+  const sensor_msgs::CameraInfo out = rectifiedCameraInfo(input, R, P);
+  EXPECT_EQ(out.header.frame_id, input.header.frame_id);
+  EXPECT_EQ(out.header.stamp, input.header.stamp);
+  EXPECT_EQ(out.width, 640u);
+  EXPECT_EQ(out.K, input.K);
+  EXPECT_EQ(out.D, input.D);
+  EXPECT_EQ(out.distortion_model, "plumb_bob");
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) EXPECT_EQ(out.R[3 * i + j], R(i, j));
+    for (int j = 0; j < 4; ++j) EXPECT_EQ(out.P[4 * i + j], P(i, j));
+  }
+  input.D = {0.0, 0.0, 0.0, 0.0, 0.0};
+  EXPECT_EQ(rectifiedCameraInfo(input, R, P).D, (std::vector<double>{1e-12, 0.0, 0.0, 0.0, 0.0}));
+  input.D.clear();
+  input.distortion_model.clear();
+  const sensor_msgs::CameraInfo empty = rectifiedCameraInfo(input, R, P);
+  EXPECT_EQ(empty.distortion_model, "plumb_bob");
+  EXPECT_EQ(empty.D, (std::vector<double>{1e-12, 0.0, 0.0, 0.0, 0.0}));
+}
+
+// The rectification parameters are validated, each problem naming its key.
+TEST(RosConfig, RectificationParametersAreValidatedByName) {
+  RosConfig config;
+  EXPECT_TRUE(config.validate().empty());
+  config.rectification_alpha = 1.5;
+  config.rectification_width = 640;  // height left at 0
+  config.rectification_update_px = -0.1;
+  const std::vector<std::string> problems = config.validate();
+  ASSERT_EQ(problems.size(), 3u);
+  EXPECT_NE(problems[0].find("rectification_alpha"), std::string::npos);
+  EXPECT_NE(problems[1].find("rectification_height"), std::string::npos);
+  EXPECT_NE(problems[2].find("rectification_update_px"), std::string::npos);
+}
+
+// Quality fields: -1 and 0 pairs when the pair had no stereo pair.
+TEST(CalibrationMessage, QualityFields) {
+  StereoCalibration message;
+  osc::CalibrationQuality quality;
+  quality.depth_sigma_10m = 0.03;
+  quality.depth_sigma_50m = 0.7;
+  setQualityFields(quality, &message);
+  EXPECT_EQ(message.rectification_error, -1.0);
+  EXPECT_EQ(message.rectification_pairs, 0u);
+  EXPECT_EQ(message.depth_sigma_10m, 0.03);
+  EXPECT_EQ(message.depth_sigma_50m, 0.7);
+  quality.rectification_error = osc::RectificationError{0.04, 55};
+  setQualityFields(quality, &message);
+  EXPECT_EQ(message.rectification_error, 0.04);
+  EXPECT_EQ(message.rectification_pairs, 55u);
 }
 
 TEST(CalibrationMessage, TransformsEqualParametersUnderInterfaceConventions) {

@@ -7,6 +7,7 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include <diagnostic_updater/update_functions.h>
 
 #include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
+#include "online_stereo_calibration/core/pipeline/live_rectification.h"
 #include "online_stereo_calibration/ros/ros_config.h"
 
 namespace online_stereo_calibration {
@@ -35,6 +37,9 @@ class CalibrationDiagnostics {
   void recordProblem(const std::string& kind, const std::string& message);
   /// The estimate after a processed pair and its StereoCalibration state.
   void recordEstimate(const osc::CalibrationEstimate& estimate, uint8_t state);
+  /// The quality figures of the estimate after a processed pair (issue 16), reported as
+  /// "rectification error [px]", "depth sigma at 10 m [m]", "depth sigma at 50 m [m]".
+  void recordQuality(const osc::CalibrationQuality& quality);
   /// ~reset was called: the estimate is forgotten until the next processed pair, and the
   /// number of resets is reported.
   void recordReset();
@@ -85,6 +90,7 @@ class CalibrationDiagnostics {
   bool have_estimate_ = false;
   osc::CalibrationEstimate estimate_;
   uint8_t state_ = 0;
+  std::optional<osc::CalibrationQuality> quality_;  ///< of the last processed pair
 };
 
 }  // namespace online_stereo_calibration

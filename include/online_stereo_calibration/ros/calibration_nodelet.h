@@ -57,6 +57,9 @@ class CalibrationNodelet : public nodelet::Nodelet {
                     const sensor_msgs::CameraInfoConstPtr& right_info);
   void workerLoop();
   void processPair(const StereoPair& pair);
+  /// Publishes ~left/camera_info and ~right/camera_info for a processed pair: R and P of the
+  /// current estimate (recomputed only past rectification_update_px).
+  void publishRectification(const StereoPair& pair, const osc::StereoExtrinsics& estimate);
   /// Creates or re-creates the pipeline for new intrinsics; false (pair refused, reported) if
   /// they are unusable or do not describe the images.
   bool preparePipeline(const StereoPair& pair, const cv::Mat& left_image,
@@ -108,6 +111,8 @@ class CalibrationNodelet : public nodelet::Nodelet {
   ros::Time last_stamp_;
   ros::Time last_saved_stamp_;
   osc::CameraIntrinsics left_intrinsics_, right_intrinsics_;
+  /// R and P of the published ~left/camera_info, ~right/camera_info; quality figures.
+  std::unique_ptr<osc::LiveRectification> rectification_;
   OutputFrames frames_;
 };
 

@@ -21,6 +21,14 @@ namespace online_stereo_calibration {
 /// number of coefficients, non-positive size).
 osc::CameraIntrinsics intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info);
 
+/// The CameraInfo of the rectification that follows the calibration: the input's header,
+/// size, binning, ROI, distortion model, K and D, with @p R (raw optical -> rectified) and
+/// @p P (rectified projection, px) of osc::StereoRectification. A D that is all zero (or
+/// empty) gets k1 = 1e-12: image_geometry leaves such an image unrectified whatever R says.
+sensor_msgs::CameraInfo rectifiedCameraInfo(const sensor_msgs::CameraInfo& input,
+                                            const Eigen::Matrix3d& R,
+                                            const Eigen::Matrix<double, 3, 4>& P);
+
 /// Why an image message's buffer cannot hold its pixels (step shorter than a row, data
 /// shorter than step x height), or "" if it can. @p bytes_per_pixel: of its encoding.
 /// Checked before the pixels are touched: a short buffer would be read past its end.

@@ -1,6 +1,7 @@
 /// @file output_publisher.h
 /// @brief Everything the nodelet publishes after an image pair: /tf, ~calibration,
-/// ~tracked_points, ~debug_image (only when subscribed) and ~markers.
+/// ~tracked_points, ~debug_image (only when subscribed), ~markers and the rectified
+/// ~left/camera_info, ~right/camera_info.
 #pragma once
 
 #include <string>
@@ -14,9 +15,10 @@
 #include <opencv2/core/mat.hpp>
 
 #include "online_stereo_calibration/StereoCalibration.h"
+#include "online_stereo_calibration/core/estimator/convergence.h"
 #include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
-#include "online_stereo_calibration/core/estimator/convergence.h"
+#include "online_stereo_calibration/core/pipeline/live_rectification.h"
 
 namespace online_stereo_calibration {
 
@@ -39,6 +41,10 @@ StereoCalibration makeCalibrationMessage(const osc::CalibrationEstimate& estimat
                                          const ros::Time& stamp, const OutputFrames& frames,
                                          uint8_t state, double processing_time);
 
+/// Sets the quality fields of @p message (rectification_error -1 when the pair had no stereo
+/// pair; StereoCalibration.msg).
+void setQualityFields(const osc::CalibrationQuality& quality, StereoCalibration* message);
+
 /// The tracked points as an x, y, z float32 cloud in the left optical frame.
 sensor_msgs::PointCloud2 makePointCloud(const std::vector<osc::PointEstimate>& points,
                                         const std_msgs::Header& header);
@@ -59,6 +65,11 @@ class OutputPublisher {
                           const osc::CalibrationEstimate& estimate);
   /// Publishes ~tracked_points.
   void publishPoints(const std::vector<osc::PointEstimate>& points, const std_msgs::Header& header);
+  /// Publishes ~left/camera_info and ~right/camera_info: the inputs with R and P of
+  /// @p rectification (one pair of CameraInfo per processed image pair).
+  void publishRectifiedCameraInfo(const sensor_msgs::CameraInfo& left_input,
+                                  const sensor_msgs::CameraInfo& right_input,
+                                  const osc::StereoRectification& rectification);
   /// True if anyone subscribes to ~debug_image (render it only then).
   bool debugImageWanted() const;
   /// Publishes a BGR debug image.
@@ -70,6 +81,7 @@ class OutputPublisher {
   ros::Publisher calibration_pub_;
   ros::Publisher points_pub_;
   ros::Publisher markers_pub_;
+  ros::Publisher left_info_pub_, right_info_pub_;
   image_transport::Publisher debug_pub_;
 };
 

@@ -60,6 +60,16 @@ struct RosConfig {
   double min_rate = 1.0;    ///< Hz, input rates below are warned about
   double max_rate = 100.0;  ///< Hz, input rates above are warned about
 
+  // Rectified camera_info (~left/camera_info, ~right/camera_info) from the current estimate.
+  bool publish_rectification = true;  ///< publish the pair of rectified camera_info
+  /// cv::stereoRectify's free scaling: 0 = only valid pixels, 1 = all pixels, -1 = default.
+  double rectification_alpha = 0.0;
+  int rectification_width = 0;   ///< px, rectified image width; 0 = the input's
+  int rectification_height = 0;  ///< px, rectified image height; 0 = the input's
+  /// px: R and P are recomputed only when the estimate moved the rectified images by more
+  /// (osc::rectificationChangePx).
+  double rectification_update_px = 0.1;
+
   /// Every problem, each naming the parameter, its value and what is allowed.
   std::vector<std::string> validate() const;
 };

@@ -56,9 +56,9 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
   }
-  const std::vector<StereoObservation> observations = front_end_->observe(
-      left_mono, right_mono, motion_since_last_processed, estimator_->filter(), &result.front_end);
-  result.estimator = estimator_->processFrame(motion_since_last_processed, observations);
+  result.stereo_pairs = front_end_->observe(left_mono, right_mono, motion_since_last_processed,
+                                            estimator_->filter(), &result.front_end);
+  result.estimator = estimator_->processFrame(motion_since_last_processed, result.stereo_pairs);
   front_end_->commit(result.estimator, estimator_->filter());
   result.processed = true;
   result.status = result.estimator.motion_rejected ? "processed (motion rejected, tracks reset)"

@@ -37,6 +37,9 @@ struct PipelineResult {
   std::string status;
   FrameReport estimator;  ///< the estimator's report (valid if processed)
   FrontEndStatistics front_end;
+  /// The stereo pairs of this image pair handed to the estimator (tracked points, then new
+  /// candidates; raw pixels), e.g. for the rectification error (live_rectification.h).
+  std::vector<StereoObservation> stereo_pairs;
   CalibrationEstimate estimate;  ///< the estimate after this pair
   /// A knocked right camera: no stereo pair found in this and the previous pair although
   /// both images had features and the whole-image fits of both contradict x_camr, or the
