@@ -108,6 +108,21 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "rotation 1 sigma re-opened after a detected jump"),
       real("jump_translation_sigma_m", &C::jump_translation_sigma, 1.0, 0.0, 10.0,
            "translation 1 sigma re-opened after a detected jump"),
+      real("consistency_window_s", &C::consistency_window, 1.0, 0.0, 1e4,
+           "window of the per-block score test of the updates' consistency (0 = off, as the "
+           "paper; consistency_monitor.h)"),
+      real("consistency_startup_s", &C::consistency_startup, 1.0, 0.0, 1e6,
+           "after a reset or a re-opened block the monitor reports but does not act on x_caml "
+           "this long"),
+      real("consistency_false_alarm", &C::consistency_false_alarm, 1.0, 1e-9, 0.5,
+           "probability that a consistent filter's window statistic exceeds its chi-square bound"),
+      real("max_drift_inflation", &C::max_drift_inflation, 1.0, 1.0, 1e6,
+           "largest factor on the variance of a calibration block's random walk (eq. 10-13) "
+           "while its measurements disagree with the model"),
+      real("drift_inflation_decade_s", &C::drift_inflation_decade, 1.0, 1e-3, 1e4,
+           "time for that factor to grow tenfold while the block's statistic is above its bound"),
+      real("drift_inflation_relax_s", &C::drift_inflation_relax, 1.0, 0.0, 1e6,
+           "time constant of the factor's logarithm relaxing to 0 once consistent (0 = at once)"),
   };
   return table;
 }
@@ -150,6 +165,7 @@ FilterConfig paperFilterConfig() {
   config.motion_noise_model = MotionNoiseModel::kPerPoint;
   config.motion_translation_noise = 0.0;  // "not considered in this paper"
   config.motion_excitation_window = 0.0;  // the paper linearises at the measured motion
+  config.consistency_window = 0.0;        // the paper's random walk is fixed
   return config;
 }
 
