@@ -217,6 +217,29 @@ TEST(ConsistencyMonitor, CommonNoiseExcessDoesNotRaiseTheCalibration) {
   EXPECT_LT(acting, 15);
 }
 
+// After a reset x_caml is only reported for consistency_startup_s; x_camr is acted on at once.
+TEST(ConsistencyMonitor, HoldsTheVehicleToLeftBlockDuringStartUp) {
+  std::mt19937 rng(19);
+  const SyntheticUpdate u(&rng);
+  FilterConfig config = monitorConfig();
+  config.consistency_startup = 5.0;
+  ConsistencyMonitor monitor(config);
+  VectorXd shift = VectorXd::Zero(u.G);
+  shift.head<12>() = 2.0 * u.P.diagonal().head<12>().cwiseSqrt();  // both blocks 2 sigma off
+  int camr_first = -1, caml_first = -1;
+  for (int k = 0; k < 100; ++k) {
+    const UpdateScores s = u.draw(&rng, shift);
+    monitor.addUpdate(0.1, &s);
+    if (camr_first < 0 && monitor.status().acting(ConsistencyBlock::kLeftToRight)) camr_first = k;
+    if (caml_first < 0 && monitor.status().acting(ConsistencyBlock::kVehicleToLeft)) caml_first = k;
+  }
+  EXPECT_GE(camr_first, 0);
+  EXPECT_LT(camr_first, 10);
+  EXPECT_GE(caml_first, 49);  // 5 s at 10 Hz
+  EXPECT_LT(caml_first, 60);
+  EXPECT_GT(monitor.inflation(ConsistencyBlock::kVehicleToLeft), 1.0);
+}
+
 TEST(ConsistencyMonitor, OffDoesNothing) {
   FilterConfig config = monitorConfig();
   config.consistency_window = 0.0;
