@@ -24,8 +24,8 @@
 /// the random walk leaves the filter lagging by a roughly constant delta, which every
 /// update's score shows in the same direction: the summed score's noncentrality
 /// delta^T (sum F) delta grows with the window, while summing the per-update statistics
-/// would only grow the sum's variance too (a window of W updates needs a sqrt(W) times
-/// larger lag). The per-step information on x_camr's yaw is small against the filter's own
+/// would grow the sum's variance too (over W updates it needs a sqrt(W) times larger
+/// noncentrality). The per-step information on x_camr's yaw is small against the filter's own
 /// (points' depths absorb most of it), so this matters: a 3 sigma lag raised the mean of
 /// the per-update statistics by a few % only. T_b / dim b is compared with the chi-square
 /// upper quantile of the configured false-alarm probability. The points' statistic is the
