@@ -29,6 +29,31 @@ const char* stateName(uint8_t state) {
   return "UNKNOWN";
 }
 
+/// The consistency monitor (core/filter/consistency_monitor.h): each block's window
+/// statistic per degree of freedom against its bound, the drift-noise factors, and a WARN
+/// while it raises a block's process noise.
+void addConsistency(const osc::ConsistencyStatus& consistency,
+                    diagnostic_updater::DiagnosticStatusWrapper* status, unsigned char* level,
+                    std::vector<std::string>* reasons) {
+  if (!consistency.enabled) return;
+  for (int k = 0; k < osc::kConsistencyBlocks; ++k) {
+    std::ostringstream value;
+    value << consistency.statistic[k] << " (bound " << consistency.bound[k] << ")";
+    status->add(std::string("consistency ") +
+                    osc::consistencyBlockName(static_cast<osc::ConsistencyBlock>(k)),
+                value.str());
+  }
+  std::ostringstream factors;
+  factors << consistency.inflation[0] << ", " << consistency.inflation[1];
+  status->add("drift noise factor (x_caml, x_camr)", factors.str());
+  const std::string message = consistency.message();
+  status->add("consistency", message.empty() ? "measurements agree with the model" : message);
+  if (consistency.acting()) {
+    *level = std::max<unsigned char>(*level, diagnostic_msgs::DiagnosticStatus::WARN);
+    reasons->push_back(message);
+  }
+}
+
 }  // namespace
 
 CalibrationDiagnostics::CalibrationDiagnostics(ros::NodeHandle& nh, ros::NodeHandle& private_nh,
@@ -204,6 +229,7 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
     }
     status.add("not determined by the motion", undetermined.empty() ? "-" : undetermined);
     if (!undetermined.empty()) reasons.push_back(undetermined);
+    addConsistency(estimate_.consistency, &status, &level, &reasons);
     if (static_cast<int>(estimate_.tracked_points) < config_.min_tracked_points) {
       level = std::max<unsigned char>(level, DiagnosticStatus::WARN);
       reasons.push_back("too few points");

@@ -116,6 +116,21 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "than this many start sigmas"),
       integer("max_relinearizations", &C::max_relinearizations, 0, 1000,
               "restarts at most after one start or re-opening"),
+      real("consistency_window_s", &C::consistency_window, 1.0, 0.0, 1e4,
+           "window of the per-block score test of the updates' consistency (0 = off, as the "
+           "paper; consistency_monitor.h)"),
+      real("consistency_startup_s", &C::consistency_startup, 1.0, 0.0, 1e6,
+           "after a reset or a re-opened block the monitor reports but does not act on x_caml "
+           "this long"),
+      real("consistency_false_alarm", &C::consistency_false_alarm, 1.0, 1e-9, 0.5,
+           "probability that a consistent filter's window statistic exceeds its chi-square bound"),
+      real("max_drift_inflation", &C::max_drift_inflation, 1.0, 1.0, 1e6,
+           "largest factor on the variance of a calibration block's random walk (eq. 10-13) "
+           "while its measurements disagree with the model"),
+      real("drift_inflation_decade_s", &C::drift_inflation_decade, 1.0, 1e-3, 1e4,
+           "time for that factor to grow tenfold while the block's statistic is above its bound"),
+      real("drift_inflation_relax_s", &C::drift_inflation_relax, 1.0, 0.0, 1e6,
+           "time constant of the factor's logarithm relaxing to 0 once consistent (0 = at once)"),
   };
   return table;
 }
@@ -158,6 +173,8 @@ FilterConfig paperFilterConfig() {
   config.motion_noise_model = MotionNoiseModel::kPerPoint;
   config.motion_translation_noise = 0.0;  // "not considered in this paper"
   config.motion_excitation_window = 0.0;  // the paper linearises at the measured motion
+  config.consistency_window = 0.0;        // the paper's random walk is fixed
+  config.relinearization_frames = 0;      // the paper's filter runs on from its start
   return config;
 }
 

@@ -251,6 +251,7 @@ CalibrationEstimate StereoCalibrationEstimator::estimate() const {
   e.parameter_covariance = filter_.parameterCovariance();
   e.tracked_points = filter_.pointCount();
   e.excitation = filter_.excitationGains();
+  e.consistency = filter_.consistency();
   return e;
 }
 

@@ -129,7 +129,7 @@ bool samePoints(const std::vector<Point>& a, const std::vector<Point>& b) {
 }  // namespace
 
 CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoIntrinsics& intrinsics)
-    : config_(config), excitation_(config), intrinsics_(intrinsics) {
+    : config_(config), excitation_(config), intrinsics_(intrinsics), monitor_(config) {
   const std::vector<std::string> problems = config.validate();
   if (!problems.empty()) {
     std::string message = "invalid filter configuration:";
@@ -162,6 +162,7 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& co
   extrinsics_ = guess;
   covariance_ = covariance;
   excitation_.reset();
+  monitor_.reset();
   points_.clear();
   index_.clear();
 }
@@ -192,7 +193,13 @@ std::string CalibrationFilter::checkMotion(const MotionIncrement& m) const {
 void CalibrationFilter::applyCalibrationDrift(double dt) {
   // g' = g + w (eq. 10-13). Each point is re-regressed on g' so that its marginal and its
   // cross-covariance with g' stay exact: B' = B P P'^-1, D' = D + B (P - P P'^-1 P) B^T.
-  const Matrix12d P_next = covariance_ + calibrationDriftCovariance(config_, dt);
+  // The consistency monitor's factor per block (1 unless the block's measurements disagree).
+  Matrix12d drift = calibrationDriftCovariance(config_, dt);
+  drift.block<6, 6>(layout::kCaml, layout::kCaml) *=
+      monitor_.inflation(ConsistencyBlock::kVehicleToLeft);
+  drift.block<6, 6>(layout::kCamr, layout::kCamr) *=
+      monitor_.inflation(ConsistencyBlock::kLeftToRight);
+  const Matrix12d P_next = covariance_ + drift;
   const Matrix12d M = P_next.llt().solve(covariance_).transpose();  // P P'^-1
   const Matrix12d forgotten = covariance_ - M * covariance_;
   for (TrackedPoint& point : points_) {
@@ -283,6 +290,9 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
     linearization.T_prev_curr = boxPlus(linearization.T_prev_curr, estimated_motion_error);
     prior_motion_error = boxMinus(motion.T_prev_curr, linearization.T_prev_curr);
   }
+  if (report.jump != JumpBlock::kNone) monitor_.clearWindow();  // the evidence was the jump's
+  monitor_.addUpdate(motion.dt, has_scores_ ? &scores_ : nullptr);
+  report.consistency = monitor_.status();
   report.accepted = true;
   return report;
 }
@@ -291,6 +301,7 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
                                 const std::vector<PointMeasurement>& measurements, bool final_pass,
                                 bool detect_jump, StepReport* out, Vector6d* motion_error) {
   StepReport& report = *out;
+  has_scores_ = false;
   // ---- prediction (Sec. II-B) ----
   const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
   std::vector<bool> remove;
@@ -365,6 +376,13 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   VectorXd dg = VectorXd::Zero(G);  // prior mean of the global error
   if (shared) dg.tail<6>() = prior_motion_error;
   double nis_sum = 0.0;
+  // The update's information for the consistency monitor (consistency_monitor.h):
+  // A = sum J^T S0^-1 J, b = sum J^T S0^-1 v, c = sum v^T S0^-1 v with v = r - J dg_prior.
+  const bool monitored = final_pass && config_.consistency_window > 0.0 && !used.empty();
+  const VectorXd dg_prior = dg;
+  MatrixXd information = monitored ? MatrixXd::Zero(G, G) : MatrixXd();
+  VectorXd score = monitored ? VectorXd::Zero(G) : VectorXd();
+  double residual_norm = 0.0;
   for (const PointInnovation* inn : used) {
     const MatrixXd PJt = P * inn->J.transpose();
     const Eigen::Matrix4d S = inn->J * PJt + inn->S0;
@@ -378,8 +396,21 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
     dg += K * (inn->residual - inn->J * dg);
     P.noalias() -= K * PJt.transpose();
     nis_sum += inn->nis;
+    if (monitored) {
+      const Eigen::Matrix4d S0_inverse = inn->S0.inverse();
+      const Eigen::Vector4d v = inn->residual - inn->J * dg_prior;
+      const MatrixXd JtS0i = inn->J.transpose() * S0_inverse;
+      information.noalias() += JtS0i * inn->J;
+      score.noalias() += JtS0i * v;
+      residual_norm += v.dot(S0_inverse * v);
+    }
   }
   P = 0.5 * (P + P.transpose());
+  if (monitored) {
+    scores_ = computeUpdateScores(information, score, residual_norm, P,
+                                  layout::kMeasurementDim * static_cast<int>(used.size()));
+    has_scores_ = true;
+  }
   *motion_error = shared ? Vector6d(dg.tail<6>()) : Vector6d::Zero();
   if (!final_pass) return true;
   report.measurements_used = static_cast<int>(used.size());
@@ -595,6 +626,7 @@ std::vector<PointId> CalibrationFilter::reopen(JumpBlock block, double translati
   points_.clear();
   index_.clear();
   last_prediction_.reset();
+  monitor_.clearWindow();
   widenBlock(block, translation_sigma, rotation_sigma);
   return removed;
 }

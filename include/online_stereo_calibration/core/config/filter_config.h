@@ -98,6 +98,21 @@ struct FilterConfig {
   /// ... at most this many times after one start or re-opening.
   int max_relinearizations = 4;
 
+  // --- consistency monitor and adaptive drift noise (consistency_monitor.h) ---
+  /// Sliding window (s) of the per-block score test of the updates; 0 = off (the paper).
+  double consistency_window = 4.0;
+  /// s after a reset or a re-opened block during which the monitor reports but does not act
+  /// on x_caml (consistency_monitor.h says why).
+  double consistency_startup = 20.0;
+  /// Probability that a consistent filter's window statistic exceeds its bound (per test).
+  double consistency_false_alarm = 1e-3;
+  /// Largest factor on the variance of a block's random walk (eq. 10-13).
+  double max_drift_inflation = 100.0;
+  /// s for the factor to grow tenfold while the block's statistic is above its bound.
+  double drift_inflation_decade = 2.0;
+  /// s, time constant of the factor's logarithm relaxing to 0 once consistent.
+  double drift_inflation_relax = 30.0;
+
   /// Every problem found, each naming the parameter, its value and the allowed range.
   std::vector<std::string> validate() const;
 };

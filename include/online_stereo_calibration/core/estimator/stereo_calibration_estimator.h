@@ -29,6 +29,8 @@ struct CalibrationEstimate {
   /// MotionExcitation gains of the recent vehicle rotation (roll, pitch, yaw), in [0, 1]:
   /// which parts of x_caml the current motion can determine (unexcitedTranslationAxes).
   Eigen::Vector3d excitation = Eigen::Vector3d::Ones();
+  /// The filter's consistency monitor: per-block statistics and the drift-noise factors.
+  ConsistencyStatus consistency;
 
   /// 1-sigma of each parameter (sqrt of the covariance diagonal).
   Vector12d sigmas() const { return parameter_covariance.diagonal().cwiseMax(0.0).cwiseSqrt(); }

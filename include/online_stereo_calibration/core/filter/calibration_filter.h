@@ -22,6 +22,7 @@
 
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/types.h"
+#include "online_stereo_calibration/core/filter/consistency_monitor.h"
 #include "online_stereo_calibration/core/filter/measurement_model.h"
 #include "online_stereo_calibration/core/filter/motion_excitation.h"
 #include "online_stereo_calibration/core/filter/unscented_transform.h"
@@ -68,6 +69,9 @@ struct StepReport {
   JumpBlock jump = JumpBlock::kNone;  ///< a sudden calibration change was detected
   bool covariance_repaired = false;   ///< the calibration covariance had to be made PD
   double mean_nis = 0.0;              ///< mean normalised innovation squared of used points (4 dof)
+  /// The consistency monitor after this step (per-block window statistics, bounds, the
+  /// drift-noise factors it set; consistency_monitor.h).
+  ConsistencyStatus consistency;
 };
 
 /// Structured UKF for the stereo extrinsics and the tracked points.
@@ -116,6 +120,9 @@ class CalibrationFilter {
   /// The full (12 + 3N)^2 covariance the structured form represents, points in the order
   /// of points(). For tests and diagnostics; O(N^2).
   Eigen::MatrixXd denseCovariance() const;
+
+  /// The consistency monitor's state: per-block statistics and the drift-noise factors.
+  const ConsistencyStatus& consistency() const { return monitor_.status(); }
 
   const FilterConfig& config() const { return config_; }
   const StereoIntrinsics& intrinsics() const { return intrinsics_; }
@@ -172,6 +179,11 @@ class CalibrationFilter {
   /// from the same state, reuses it instead of repeating the per-point UTs (so neither
   /// predictObservations nor step may run concurrently on one filter).
   mutable std::shared_ptr<const Prediction> last_prediction_;
+  /// Per-block score test of the updates; scales the random walk of eq. 10-13 per block.
+  ConsistencyMonitor monitor_;
+  /// The final pass's scores of this step, for the monitor (has_scores_: an update ran).
+  UpdateScores scores_;
+  bool has_scores_ = false;
 };
 
 }  // namespace osc

@@ -1,0 +1,224 @@
+#include "online_stereo_calibration/core/filter/consistency_monitor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+
+#include "online_stereo_calibration/core/filter/state_layout.h"
+
+namespace osc {
+namespace {
+
+/// Upper standard normal quantile: P(Z > z) = probability, by bisection on erfc.
+double normalUpperQuantile(double probability) {
+  double lo = -40.0, hi = 40.0;
+  for (int k = 0; k < 200; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    if (0.5 * std::erfc(mid / M_SQRT2) > probability) {
+      lo = mid;
+    } else {
+      hi = mid;
+    }
+  }
+  return 0.5 * (lo + hi);
+}
+
+/// g_S^T F_SS^+ g_S over the index set S, and the rank of F_SS: directions the update
+/// carries (relatively) no information on are left out, with their degrees of freedom.
+double quadraticForm(const Eigen::MatrixXd& F, const Eigen::VectorXd& g,
+                     const std::vector<int>& indices, int* rank) {
+  const int n = static_cast<int>(indices.size());
+  Eigen::MatrixXd F_s(n, n);
+  Eigen::VectorXd g_s(n);
+  for (int a = 0; a < n; ++a) {
+    g_s(a) = g(indices[a]);
+    for (int b = 0; b < n; ++b) F_s(a, b) = F(indices[a], indices[b]);
+  }
+  // Scale to unit diagonal first: the blocks mix metres and radians.
+  Eigen::VectorXd scale = F_s.diagonal().cwiseMax(0.0).cwiseSqrt();
+  for (int a = 0; a < n; ++a) scale(a) = scale(a) > 0.0 ? 1.0 / scale(a) : 0.0;
+  F_s = scale.asDiagonal() * F_s * scale.asDiagonal();
+  g_s = scale.asDiagonal() * g_s;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(F_s);
+  const double largest = eigen.eigenvalues().maxCoeff();
+  double value = 0.0;
+  *rank = 0;
+  if (!(largest > 0.0)) return 0.0;
+  for (int k = 0; k < n; ++k) {
+    const double lambda = eigen.eigenvalues()(k);
+    if (lambda <= 1e-9 * largest) continue;
+    const double projection = eigen.eigenvectors().col(k).dot(g_s);
+    value += projection * projection / lambda;
+    ++*rank;
+  }
+  return value;
+}
+
+std::vector<int> indexRange(int first, int count) {
+  std::vector<int> r(count);
+  for (int k = 0; k < count; ++k) r[k] = first + k;
+  return r;
+}
+
+}  // namespace
+
+const char* consistencyBlockName(ConsistencyBlock block) {
+  switch (block) {
+    case ConsistencyBlock::kVehicleToLeft:
+      return "x_caml";
+    case ConsistencyBlock::kLeftToRight:
+      return "x_camr";
+    case ConsistencyBlock::kPoints:
+      return "points";
+  }
+  return "?";
+}
+
+std::string ConsistencyStatus::message() const {
+  const bool left = acting(ConsistencyBlock::kVehicleToLeft);
+  const bool right = acting(ConsistencyBlock::kLeftToRight);
+  if (left || right) {
+    return std::string("measurements disagree with the model: process noise raised on ") +
+           (left && right ? "x_caml and x_camr"
+            : left        ? "x_caml"
+                          : "x_camr");
+  }
+  if (exceeded[static_cast<int>(ConsistencyBlock::kPoints)]) {
+    return "measurements disagree with the model: not explained by the calibration (points, "
+           "motion or pixel noise)";
+  }
+  return "";
+}
+
+double chiSquareUpperQuantile(double dof, double probability) {
+  if (!(dof > 0.0)) return 0.0;
+  // Wilson-Hilferty: (X / k)^(1/3) is close to normal with mean 1 - 2/(9k), var 2/(9k).
+  const double v = 2.0 / (9.0 * dof);
+  const double root = 1.0 - v + normalUpperQuantile(probability) * std::sqrt(v);
+  return dof * std::max(root, 0.0) * root * root;
+}
+
+void calibrationStatistics(const Eigen::Matrix<double, 12, 1>& g,
+                           const Eigen::Matrix<double, 12, 12>& F, std::array<double, 2>* statistic,
+                           std::array<int, 2>* dof) {
+  const Eigen::VectorXd gd = g;
+  const Eigen::MatrixXd Fd = F;
+  int rank_caml = 0, rank_camr = 0, rank_both = 0;
+  const double t_caml =
+      quadraticForm(Fd, gd, indexRange(layout::kCaml, layout::kPoseDim), &rank_caml);
+  const double t_camr =
+      quadraticForm(Fd, gd, indexRange(layout::kCamr, layout::kPoseDim), &rank_camr);
+  const double t_both = quadraticForm(Fd, gd, indexRange(0, layout::kCalibrationDim), &rank_both);
+  // Partial scores: each block with the other one free, T_{b|o} = T_{b+o} - T_o.
+  (*statistic)[0] = std::max(t_both - t_camr, 0.0);
+  (*dof)[0] = std::max(rank_both - rank_camr, 0);
+  (*statistic)[1] = std::max(t_both - t_caml, 0.0);
+  (*dof)[1] = std::max(rank_both - rank_caml, 0);
+}
+
+UpdateScores computeUpdateScores(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
+                                 double residual_norm, const Eigen::MatrixXd& P_post,
+                                 int measurement_dof) {
+  UpdateScores scores;
+  const int G = static_cast<int>(A.rows());
+  // Score and its covariance of a shift of the global error beyond its prior.
+  const Eigen::VectorXd correction = P_post * b;  // the update's correction of the mean
+  const Eigen::VectorXd g = b - A * correction;
+  Eigen::MatrixXd F = A - A * P_post * A;
+  F = 0.5 * (F + F.transpose());
+  scores.score = g.head<12>();
+  scores.information = F.topLeftCorner<12, 12>();
+  // Total NIS of the update, r^T S^-1 r by Woodbury, less what the global block explains.
+  int rank_all = 0;
+  const double t_all = quadraticForm(F, g, indexRange(0, G), &rank_all);
+  const double total = residual_norm - b.dot(correction);
+  scores.rest = std::max(total - t_all, 0.0);
+  scores.rest_dof = std::max(measurement_dof - rank_all, 0);
+  return scores;
+}
+
+ConsistencyMonitor::ConsistencyMonitor(const FilterConfig& config)
+    : enabled_(config.consistency_window > 0.0),
+      window_(config.consistency_window),
+      false_alarm_(config.consistency_false_alarm),
+      max_log_inflation_(std::log(std::max(config.max_drift_inflation, 1.0))),
+      log_rate_(config.drift_inflation_decade > 0.0 ? std::log(10.0) / config.drift_inflation_decade
+                                                    : 0.0),
+      relax_time_(config.drift_inflation_relax),
+      startup_(config.consistency_startup) {
+  reset();
+}
+
+void ConsistencyMonitor::reset() {
+  time_ = 0.0;
+  hold_until_ = startup_;
+  window_entries_.clear();
+  log_inflation_ = {0.0, 0.0};
+  status_ = ConsistencyStatus();
+  status_.enabled = enabled_;
+}
+
+void ConsistencyMonitor::clearWindow() {
+  window_entries_.clear();
+  hold_until_ = time_ + startup_;
+  evaluate();
+}
+
+void ConsistencyMonitor::addUpdate(double dt, const UpdateScores* scores) {
+  if (!enabled_) return;
+  time_ += dt;
+  if (scores) window_entries_.push_back({time_, *scores});
+  while (!window_entries_.empty() && window_entries_.front().time <= time_ - window_) {
+    window_entries_.pop_front();
+  }
+  evaluate();
+  // The factor of a block whose disagreement is significant grows, else relaxes.
+  for (int k = 0; k < 2; ++k) {
+    if (status_.acting(static_cast<ConsistencyBlock>(k))) {
+      log_inflation_[k] = std::min(log_inflation_[k] + log_rate_ * dt, max_log_inflation_);
+    } else {
+      log_inflation_[k] *= relax_time_ > 0.0 ? std::exp(-dt / relax_time_) : 0.0;
+    }
+    status_.inflation[k] = std::exp(log_inflation_[k]);
+  }
+}
+
+void ConsistencyMonitor::evaluate() {
+  Eigen::Matrix<double, 12, 1> score = Eigen::Matrix<double, 12, 1>::Zero();
+  Eigen::Matrix<double, 12, 12> information = Eigen::Matrix<double, 12, 12>::Zero();
+  double rest = 0.0, rest_dof = 0.0;
+  for (const Entry& entry : window_entries_) {
+    score += entry.scores.score;
+    information += entry.scores.information;
+    rest += entry.scores.rest;
+    rest_dof += entry.scores.rest_dof;
+  }
+  status_.window_updates = static_cast<int>(window_entries_.size());
+  status_.holding = time_ < hold_until_;
+  std::array<double, 2> statistic = {0.0, 0.0};
+  std::array<int, 2> dof = {0, 0};
+  if (!window_entries_.empty()) calibrationStatistics(score, information, &statistic, &dof);
+  const int points = static_cast<int>(ConsistencyBlock::kPoints);
+  const std::array<double, kConsistencyBlocks> sums = {statistic[0], statistic[1], rest};
+  const std::array<double, kConsistencyBlocks> dofs = {double(dof[0]), double(dof[1]), rest_dof};
+  for (int k = 0; k < kConsistencyBlocks; ++k) {
+    status_.statistic[k] = dofs[k] > 0.0 ? sums[k] / dofs[k] : 0.0;
+    status_.bound[k] =
+        dofs[k] > 0.0 ? chiSquareUpperQuantile(dofs[k], false_alarm_) / dofs[k] : 0.0;
+  }
+  // A common excess (the noise of every measurement under-estimated) is not the calibration's.
+  const double common = std::max(status_.statistic[points], 1.0);
+  for (int k = 0; k < 2; ++k) status_.statistic[k] /= common;
+  for (int k = 0; k < kConsistencyBlocks; ++k) {
+    status_.exceeded[k] = dofs[k] > 0.0 && status_.statistic[k] > status_.bound[k];
+  }
+}
+
+double ConsistencyMonitor::inflation(ConsistencyBlock block) const {
+  const int k = static_cast<int>(block);
+  return k < 2 ? status_.inflation[k] : 1.0;
+}
+
+}  // namespace osc
