@@ -114,6 +114,9 @@ const std::vector<ParameterSpec>& filterParameterTable() {
       real("relinearization_threshold", &C::relinearization_threshold, 1.0, 0.0, 100.0,
            "restart from the current estimate with the start's covariance when it moved more "
            "than this many start sigmas"),
+      real("relinearization_nis", &C::relinearization_nis, 1.0, 0.0, 1e6,
+           "... and the updates' mean NIS per measured coordinate over those frames was above "
+           "this (1 = as expected)"),
       integer("max_relinearizations", &C::max_relinearizations, 0, 1000,
               "restarts at most after one start or re-opening"),
       real("consistency_window_s", &C::consistency_window, 1.0, 0.0, 1e4,

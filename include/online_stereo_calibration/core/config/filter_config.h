@@ -95,6 +95,10 @@ struct FilterConfig {
   /// ... and restarts when some tangent component moved more than this many of the start's
   /// 1 sigmas since then.
   double relinearization_threshold = 0.5;
+  /// ... and the mean normalised innovation squared of those frames' updates, per measured
+  /// coordinate, was above this (1 = as the model expects): a consistent filter converging
+  /// from a good guess also moves, a badly linearised one also mispredicts.
+  double relinearization_nis = 1.15;
   /// ... at most this many times after one start or re-opening.
   int max_relinearizations = 4;
 

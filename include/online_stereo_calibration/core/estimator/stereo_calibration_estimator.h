@@ -92,6 +92,9 @@ class StereoCalibrationEstimator {
     int frames = 0;    ///< accepted steps since the anchor or the last check
     int steps = 0;     ///< accepted steps since the start or re-opening (over restarts)
     int restarts = 0;  ///< restarts since the start or re-opening
+    /// Sum of NIS and number of measurements used since the last check.
+    double nis_sum = 0.0;
+    int nis_count = 0;
   };
 
   bool toMeasurement(const StereoObservation& observation, PointMeasurement* measurement) const;
@@ -104,8 +107,9 @@ class StereoCalibrationEstimator {
   /// The anchor is still checked: fewer than max_relinearizations restarts and
   /// (max_relinearizations + 1) * relinearization_frames steps since the start or re-opening.
   bool anchorIsLive() const;
-  /// Every relinearization_frames accepted steps: each anchored block that moved more than
-  /// relinearization_threshold is restarted from the current estimate with the anchor's
+  /// Every relinearization_frames accepted steps, if the innovations over them were larger
+  /// than relinearization_nis times their expected size: each anchored block that moved more
+  /// than relinearization_threshold is restarted from the current estimate with the anchor's
   /// uncertainty; every point is dropped into report->dropped. True if it did.
   bool relinearizeIfMoved(FrameReport* report);
 
