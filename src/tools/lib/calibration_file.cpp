@@ -1,4 +1,5 @@
 #include "online_stereo_calibration/tools/calibration_file.h"
+#include "online_stereo_calibration/tools/output_directory.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -131,13 +132,6 @@ bool writeAll(int fd, const std::string& data) {
     done += static_cast<std::size_t>(n);
   }
   return true;
-}
-
-std::string directoryOf(const std::string& path) {
-  const std::size_t slash = path.find_last_of('/');
-  if (slash == std::string::npos) return ".";
-  if (slash == 0) return "/";
-  return path.substr(0, slash);
 }
 
 }  // namespace

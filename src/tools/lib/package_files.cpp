@@ -1,4 +1,5 @@
 #include "online_stereo_calibration/tools/package_files.h"
+#include "online_stereo_calibration/tools/output_directory.h"
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -17,16 +18,6 @@ namespace osc {
 namespace {
 
 constexpr const char* kPackage = "online_stereo_calibration";
-
-bool isFile(const std::string& path) {
-  struct stat st;
-  return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-}
-
-std::string directoryOf(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? "." : path.substr(0, slash);
-}
 
 std::string baseName(const std::string& path) {
   const auto slash = path.find_last_of('/');
@@ -72,7 +63,7 @@ std::string findPackageFile(const std::string& relative_path, const char* enviro
   candidates.push_back(relative_path);
   candidates.push_back(std::string(OSC_PACKAGE_SOURCE_DIR) + "/" + relative_path);
   for (const std::string& c : candidates) {
-    if (isFile(c)) return c;
+    if (isRegularFile(c)) return c;
   }
   return "";
 }

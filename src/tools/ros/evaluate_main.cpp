@@ -117,16 +117,6 @@ void finishOptions(Options* o) {
   fill(&o->right_info, "right/camera_info");
 }
 
-bool isFile(const std::string& path) {
-  struct stat st;
-  return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-}
-
-std::string directoryOf(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? "." : path.substr(0, slash);
-}
-
 cv::Mat toMat(const sensor_msgs::ImageConstPtr& msg, cv_bridge::CvImageConstPtr* holder) {
   const std::string& e = msg->encoding;
   if (e == "mono8" || e == "mono16" || e == "bgr8" || e == "bgra8") {
@@ -159,8 +149,8 @@ int evaluateBag(const Options& options) {
   topics.right_info = options.right_info;
   topics.odom = options.odom;
   std::string guess_path = options.initial_guess;
-  if (guess_path.empty()) guess_path = directoryOf(options.bag) + "/initial_guess.yaml";
-  if (!isFile(guess_path)) {
+  if (guess_path.empty()) guess_path = osc::directoryOf(options.bag) + "/initial_guess.yaml";
+  if (!osc::isRegularFile(guess_path)) {
     throw std::invalid_argument("no initial guess: give --initial-guess GUESS.yaml");
   }
   const osc::CalibrationFile guess = osc::readCalibrationFile(guess_path);
