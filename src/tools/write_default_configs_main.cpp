@@ -10,6 +10,7 @@
 
 #include "online_stereo_calibration/tools/command_line.h"
 #include "online_stereo_calibration/tools/estimator_config_yaml.h"
+#include "online_stereo_calibration/tools/output_directory.h"
 
 int main(int argc, char** argv) {
   std::vector<std::string> directories;
@@ -24,16 +25,18 @@ int main(int argc, char** argv) {
         const std::string dir = directories.front();
         osc::EstimatorConfig paper;
         paper.filter = osc::paperFilterConfig();
-        std::ofstream(dir + "/default.yaml") << osc::formatEstimatorConfigYaml(
-            osc::EstimatorConfig(),
-            "online_stereo_calibration: shipped defaults (docs/RESULTS.md "
-            "has the figures behind every value that differs from "
-            "paper.yaml)");
-        std::ofstream(dir + "/paper.yaml") << osc::formatEstimatorConfigYaml(
-            paper,
-            "online_stereo_calibration: the seed paper's values (Mueller "
-            "& Wuensche 2016, eq. 10-15); values the paper does not give "
-            "are our defaults");
+        osc::writeTextFileAtomic(dir + "/default.yaml",
+                                 osc::formatEstimatorConfigYaml(
+                                     osc::EstimatorConfig(),
+                                     "online_stereo_calibration: shipped defaults (docs/RESULTS.md "
+                                     "has the figures behind every value that differs from "
+                                     "paper.yaml)"));
+        osc::writeTextFileAtomic(dir + "/paper.yaml",
+                                 osc::formatEstimatorConfigYaml(
+                                     paper,
+                                     "online_stereo_calibration: the seed paper's values (Mueller "
+                                     "& Wuensche 2016, eq. 10-15); values the paper does not give "
+                                     "are our defaults"));
         std::cout << "wrote " << dir << "/default.yaml and " << dir << "/paper.yaml\n";
         return 0;
       });

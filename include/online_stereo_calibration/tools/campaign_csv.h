@@ -55,8 +55,4 @@ std::vector<CampaignRow> parseCampaignCsv(const std::string& text, const std::st
 /// Reads a campaign CSV file (see parseCampaignCsv).
 std::vector<CampaignRow> readCampaignCsv(const std::string& path);
 
-/// Writes @p text to @p path atomically (a temporary file beside it, then rename).
-/// @throws std::runtime_error naming the path.
-void writeFileAtomic(const std::string& path, const std::string& text);
-
 }  // namespace osc

@@ -17,4 +17,10 @@ std::string directoryOf(const std::string& path);
 /// True if @p path names an existing regular file (after following links).
 bool isRegularFile(const std::string& path);
 
+/// Writes @p text to @p path atomically: a temporary file beside it (mode 0644), fsync, rename
+/// over @p path, fsync of the directory. A reader sees the old file or the whole new one, also
+/// after a crash or kill -9. @throws std::runtime_error naming the step and the errno text
+/// ("... (old file, if any, kept)").
+void writeTextFileAtomic(const std::string& path, const std::string& text);
+
 }  // namespace osc

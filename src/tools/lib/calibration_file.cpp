@@ -118,22 +118,6 @@ std::string formatList(const Vector6d& v) {
   return text + "]";
 }
 
-std::string errnoText() { return std::strerror(errno); }
-
-/// Writes all of @p data to @p fd; false on error (errno set).
-bool writeAll(int fd, const std::string& data) {
-  std::size_t done = 0;
-  while (done < data.size()) {
-    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return false;
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  return true;
-}
-
 }  // namespace
 
 CalibrationFile parseCalibrationYaml(const std::string& text, const std::string& source_name) {
@@ -226,39 +210,10 @@ std::string formatCalibrationYaml(const CalibrationFile& file) {
 
 void writeCalibrationFileAtomic(const std::string& path, const CalibrationFile& file) {
   const std::string text = formatCalibrationYaml(file);
-  const auto failure = [&path](const std::string& what) {
-    return std::runtime_error("calibration file '" + path + "': " + what);
-  };
-
-  std::string temp = path + ".tmp.XXXXXX";
-  std::vector<char> temp_buffer(temp.begin(), temp.end());
-  temp_buffer.push_back('\0');
-  const int fd = ::mkstemp(temp_buffer.data());
-  if (fd < 0) throw failure("cannot create a temporary file: " + errnoText());
-  temp.assign(temp_buffer.data());
-
-  std::string error;
-  if (::fchmod(fd, 0644) != 0) {
-    error = "chmod: " + errnoText();
-  } else if (!writeAll(fd, text)) {
-    error = "write: " + errnoText();
-  } else if (::fsync(fd) != 0) {
-    error = "fsync: " + errnoText();
-  }
-  if (::close(fd) != 0 && error.empty()) error = "close: " + errnoText();
-  if (error.empty() && ::rename(temp.c_str(), path.c_str()) != 0) {
-    error = "rename: " + errnoText();
-  }
-  if (!error.empty()) {
-    ::unlink(temp.c_str());
-    throw failure(error + " (old file, if any, kept)");
-  }
-
-  // Make the rename itself durable. Failure here leaves a complete file in place.
-  const int dir_fd = ::open(directoryOf(path).c_str(), O_RDONLY | O_DIRECTORY);
-  if (dir_fd >= 0) {
-    ::fsync(dir_fd);
-    ::close(dir_fd);
+  try {
+    writeTextFileAtomic(path, text);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error("calibration file '" + path + "': " + e.what());
   }
 }
 

@@ -77,8 +77,8 @@ std::string duration(double seconds) {
     } catch (const std::exception& e) {  // the draw itself failed
       row = failedCampaignRow(run, inputs.seed + run, inputs.frames, {}, e.what());
     }
-    writeFileAtomic(runFile(dir, run),
-                    campaignCsvHeader(names) + "\n" + formatCampaignCsvLine(row, names) + "\n");
+    writeTextFileAtomic(runFile(dir, run),
+                        campaignCsvHeader(names) + "\n" + formatCampaignCsvLine(row, names) + "\n");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "campaign: run %d: %s\n", run, e.what());
     code = 1;
@@ -142,9 +142,9 @@ void storeOrCheckCampaignInputs(const std::string& dir, const CampaignInputs& in
   const std::string campaign_text = inputsText(inputs);
   if (!exists(in + "/campaign.txt")) {
     makeDirectories(in);
-    writeFileAtomic(in + "/ranges.yaml", inputs.ranges_text);
-    writeFileAtomic(in + "/config.yaml", config_text);
-    writeFileAtomic(in + "/campaign.txt", campaign_text);  // last: marks the inputs complete
+    writeTextFileAtomic(in + "/ranges.yaml", inputs.ranges_text);
+    writeTextFileAtomic(in + "/config.yaml", config_text);
+    writeTextFileAtomic(in + "/campaign.txt", campaign_text);  // last: marks the inputs complete
     return;
   }
   std::vector<std::string> differences;
@@ -244,8 +244,8 @@ std::vector<CampaignRow> runCampaign(const CampaignInputs& inputs, const Campaig
       }
       const CampaignRow row =
           failedCampaignRow(run, inputs.seed + run, inputs.frames, settings, reason);
-      writeFileAtomic(file,
-                      campaignCsvHeader(names) + "\n" + formatCampaignCsvLine(row, names) + "\n");
+      writeTextFileAtomic(
+          file, campaignCsvHeader(names) + "\n" + formatCampaignCsvLine(row, names) + "\n");
     }
     ++done;
     for (const CampaignRow& row : readCampaignCsv(file)) honest += row.honest();
@@ -261,8 +261,8 @@ std::vector<CampaignRow> runCampaign(const CampaignInputs& inputs, const Campaig
       csv += formatCampaignCsvLine(row, names) + "\n";
     }
   }
-  writeFileAtomic(options.out + "/campaign.csv", csv);
-  writeFileAtomic(options.out + "/summary.txt", formatCampaignSummary(rows));
+  writeTextFileAtomic(options.out + "/campaign.csv", csv);
+  writeTextFileAtomic(options.out + "/summary.txt", formatCampaignSummary(rows));
   if (options.plot) {
     const std::string script = findPackageFile("scripts/plot_campaign.py");
     if (script.empty()) {

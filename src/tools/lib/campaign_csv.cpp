@@ -185,18 +185,4 @@ std::vector<CampaignRow> readCampaignCsv(const std::string& path) {
   return parseCampaignCsv(readTextFile(path), path);
 }
 
-void writeFileAtomic(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp." + std::to_string(getpid());
-  {
-    std::ofstream out(temporary);
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error("cannot write '" + temporary + "'");
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    std::remove(temporary.c_str());
-    throw std::runtime_error("cannot rename '" + temporary + "' to '" + path + "'");
-  }
-}
-
 }  // namespace osc

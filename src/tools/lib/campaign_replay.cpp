@@ -54,8 +54,8 @@ CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& o
   reference.flush();
 
   const std::vector<std::string> names = campaignSettingNames(inputs.images);
-  writeFileAtomic(dir + "/run.csv",
-                  campaignCsvHeader(names) + "\n" + formatCampaignCsvLine(row, names) + "\n");
+  writeTextFileAtomic(dir + "/run.csv",
+                      campaignCsvHeader(names) + "\n" + formatCampaignCsvLine(row, names) + "\n");
   std::ostringstream text;
   text << "run " << run << ", seed " << spec.seed << ", " << inputs.frames << " frames at 10 Hz"
        << (inputs.images ? ", images" : ", measurement level") << ": "
@@ -67,7 +67,7 @@ CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& o
        << ", converged_frame " << row.score.converged_frame << "\n\ndrawn settings:\n";
   for (const auto& [name, value] : spec.settings) text << "  " << name << " = " << value << "\n";
   if (report) *report << text.str();
-  writeFileAtomic(dir + "/settings.txt", text.str());
+  writeTextFileAtomic(dir + "/settings.txt", text.str());
 
   if (report) report->flush();  // before the script's own output
   const std::string script =
