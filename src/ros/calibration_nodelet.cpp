@@ -426,6 +426,17 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
   if (result.estimator.motion_rejected) {
     diagnostics_->recordProblem("motion rejected", result.status);
   }
+  // The estimator's own reports (issue 14): what it did at a start far off, and why it
+  // cannot start at all.
+  for (const std::string& warning : result.estimator.warnings) {
+    if (result.estimator.relinearized && warning.rfind("restarted", 0) == 0) {
+      diagnostics_->recordProblem("start re-linearised", warning);
+    }
+    if (result.estimator.no_point_initialised &&
+        warning.rfind("no point could be initialised", 0) == 0) {
+      diagnostics_->recordProblem("no point initialised", warning);
+    }
+  }
   for (const std::string& warning : result.estimator.warnings) {
     NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: %s", warning.c_str());
   }

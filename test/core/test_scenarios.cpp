@@ -236,6 +236,7 @@ TEST(Start, NoPointAtAllIsExplainedByTheBaseline) {
       const FrameReport report = estimator.processFrame(frame.measured_motion, frame.observations);
       simulator.dropTracks(report.dropped);
       for (const std::string& w : report.warnings) warnings += w + "\n";
+      EXPECT_EQ(report.no_point_initialised, yr_error > 0.09) << "frame " << frame.index;
     }
     if (yr_error > 0.09) {
       EXPECT_EQ(estimator.estimate().tracked_points, 0u);

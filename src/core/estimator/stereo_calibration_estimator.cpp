@@ -208,6 +208,7 @@ FrameReport StereoCalibrationEstimator::processFrame(
   // guessed at 1 cm stayed at 0 points for 800 frames with no other sign). Say why.
   if (filter_.pointCount() == 0 && report.rejected_new_points >= kFewestPairsToExplain &&
       report.new_points == 0) {
+    report.no_point_initialised = true;
     const CalibrationEstimate e = estimate();
     std::ostringstream message;
     message << "no point could be initialised: none of " << report.rejected_new_points

@@ -48,6 +48,9 @@ struct FrameReport {
   /// The filter was restarted from the current estimate with its start's covariance (it had
   /// moved far from where it was linearised: FilterConfig::relinearization_*).
   bool relinearized = false;
+  /// Stereo pairs came, but not one point could be initialised and the filter has none (the
+  /// left->right estimate triangulates none within the depth range: a baseline guess far off).
+  bool no_point_initialised = false;
   std::vector<std::string> warnings;  ///< human-readable, one per problem
 };
 
