@@ -36,7 +36,8 @@ struct BenchmarkProblem {
     for (int i = 0; i < n; ++i) {
       const double depth = 4.0 + 30.0 * (0.5 + 0.5 * u(rng));
       const Eigen::Vector3d p0(depth * 0.4 * u(rng), depth * 0.3 * u(rng), depth);
-      const Eigen::Vector3d p1 = T_lopt_veh * (motion.T_prev_curr.inverse() * (truth.vehicleToLeftOptical() * p0));
+      const Eigen::Vector3d p1 =
+          T_lopt_veh * (motion.T_prev_curr.inverse() * (truth.vehicleToLeftOptical() * p0));
       PointMeasurement a, b;
       a.id = b.id = i + 1;
       a.variance.setConstant(0.25);
@@ -58,9 +59,10 @@ Matrix12d convergedCovariance() {
   return sigma.array().square().matrix().asDiagonal();
 }
 
-void BM_StructuredFilterStep(benchmark::State& state) {
+/// One structured step with @p config (the shipped defaults, or the consistency monitor off).
+void structuredFilterStep(benchmark::State& state, const FilterConfig& config) {
   const BenchmarkProblem problem(static_cast<int>(state.range(0)));
-  CalibrationFilter prepared(FilterConfig(), problem.K);
+  CalibrationFilter prepared(config, problem.K);
   prepared.reset(problem.truth, convergedCovariance());
   for (const auto& m : problem.first) prepared.addPoint(m);
   for (auto _ : state) {
@@ -70,6 +72,18 @@ void BM_StructuredFilterStep(benchmark::State& state) {
     benchmark::DoNotOptimize(filter.step(problem.motion, problem.second));
   }
   state.counters["points"] = static_cast<double>(prepared.pointCount());
+}
+
+void BM_StructuredFilterStep(benchmark::State& state) {
+  structuredFilterStep(state, FilterConfig());
+}
+
+/// The same without the consistency monitor (consistency_window_s 0): what the monitor's
+/// per-update sums cost.
+void BM_StructuredFilterStepWithoutMonitor(benchmark::State& state) {
+  FilterConfig config;
+  config.consistency_window = 0.0;
+  structuredFilterStep(state, config);
 }
 
 void BM_DenseUkfStep(benchmark::State& state) {
@@ -89,7 +103,18 @@ void BM_DenseUkfStep(benchmark::State& state) {
   state.counters["points"] = static_cast<double>(prepared.pointIds().size());
 }
 
-BENCHMARK(BM_StructuredFilterStep)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Arg(400)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StructuredFilterStep)
+    ->Arg(25)
+    ->Arg(50)
+    ->Arg(100)
+    ->Arg(200)
+    ->Arg(400)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StructuredFilterStepWithoutMonitor)
+    ->Arg(25)
+    ->Arg(100)
+    ->Arg(400)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DenseUkfStep)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Unit(benchmark::kMillisecond);
 
 }  // namespace
