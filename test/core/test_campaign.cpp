@@ -1,7 +1,9 @@
 // Tests of the campaign tool's library (issue 13): ranges, drawing, scoring, the CSV, and
 // short campaigns (4 runs of 100 frames at measurement level).
 #include <gtest/gtest.h>
+
 #include <stdlib.h>
+#include "temp_dir.h"
 
 #include <cmath>
 #include <filesystem>
@@ -23,22 +25,6 @@ namespace osc {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-
-/// A fresh directory under /tmp, removed with everything in it at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    char name[] = "/tmp/osc_test_campaign_XXXXXX";
-    const char* made = ::mkdtemp(name);
-    if (made == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = made;
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
 
 std::string parseError(const std::string& yaml) {
   try {

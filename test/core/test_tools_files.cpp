@@ -20,7 +20,9 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
 #include <opencv2/core.hpp>
+#include "temp_dir.h"
 
 #include "online_stereo_calibration/core/sim/measurement_simulator.h"
 #include "online_stereo_calibration/tools/calibration_file.h"
@@ -37,39 +39,6 @@ namespace osc {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-
-/// A fresh directory under /tmp, removed (with its files) at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    char name[] = "/tmp/osc_test_tools_XXXXXX";
-    const char* made = ::mkdtemp(name);
-    if (made == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = made;
-  }
-  ~TempDir() {
-    ::chmod(path_.c_str(), 0755);
-    for (const std::string& entry : entries()) ::unlink((path_ + "/" + entry).c_str());
-    ::rmdir(path_.c_str());
-  }
-  const std::string& path() const { return path_; }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-  /// Names in the directory, without "." and "..".
-  std::set<std::string> entries() const {
-    std::set<std::string> names;
-    if (DIR* dir = ::opendir(path_.c_str())) {
-      while (const dirent* entry = ::readdir(dir)) {
-        const std::string name = entry->d_name;
-        if (name != "." && name != "..") names.insert(name);
-      }
-      ::closedir(dir);
-    }
-    return names;
-  }
-
- private:
-  std::string path_;
-};
 
 std::string readText(const std::string& path) {
   std::ifstream in(path);
