@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "online_stereo_calibration/core/sim/scenario_runner.h"
+#include "online_stereo_calibration/tools/campaign_score.h"
 
 namespace osc {
 namespace {
@@ -169,27 +170,6 @@ TEST(Observability, DISABLED_HoveringSmallRigDoesNotLearnItsBaseline) {
   }
 }
 
-/// Honesty from frame 30 on: the share of frames with all 12 errors within 3 sigma and the
-/// largest |error| / sigma (campaign.md's share_within_3sigma and max_z).
-struct Honesty {
-  double share_within_3sigma = 0.0;
-  double max_z = 0.0;
-};
-
-Honesty honestyFromFrame30(const std::vector<ScenarioFrameResult>& results) {
-  Honesty h;
-  int frames = 0, within = 0;
-  for (const ScenarioFrameResult& r : results) {
-    if (r.frame < 30) continue;
-    ++frames;
-    const Vector12d z = parameterError(r).cwiseAbs().cwiseQuotient(r.sigmas);
-    within += z.maxCoeff() <= 3.0 ? 1 : 0;
-    h.max_z = std::max(h.max_z, z.maxCoeff());
-  }
-  h.share_within_3sigma = frames > 0 ? static_cast<double>(within) / frames : 0.0;
-  return h;
-}
-
 // Issue 14: x_camr's angles 5 deg off (2.5 sigma of the 2 deg prior). New points triangulated
 // and first updates linearised that far off locked the filter onto a wrong x_camr with a
 // small sigma (yaw_r 176 sigma off, all 12 within 3 sigma in 0 % of the frames, seed 1).
@@ -208,10 +188,10 @@ TEST(Start, FarOffRightCameraAnglesAreRelinearisedNotLockedIn) {
   double worst_without = 0.0;
   for (unsigned seed : {1u, 2u, 3u}) {
     scenario.seed = seed;
-    const Honesty with = honestyFromFrame30(runMeasurementScenario(scenario, FilterConfig()));
+    const CampaignScore with = scoreCampaignRun(runMeasurementScenario(scenario, FilterConfig()));
     EXPECT_GE(with.share_within_3sigma, 0.85) << "seed " << seed;
     EXPECT_LT(with.max_z, 12.0) << "seed " << seed;
-    const Honesty old = honestyFromFrame30(runMeasurementScenario(scenario, without));
+    const CampaignScore old = scoreCampaignRun(runMeasurementScenario(scenario, without));
     worst_without = std::max(worst_without, old.max_z);
   }
   EXPECT_GT(worst_without, 30.0);  // the case the re-linearisation is for
