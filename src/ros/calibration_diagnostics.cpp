@@ -223,9 +223,14 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
     static const char* const kNeeds[3] = {"no pitch/yaw excitation", "no roll/yaw excitation",
                                           "no roll/pitch excitation"};
     std::string undetermined;
+    const std::vector<int> scale_limited =
+        osc::scaleLimitedParameters(estimate_, config_.converged);
     for (int i : osc::undeterminedParameters(estimate_, config_.converged)) {
+      const bool by_scale =
+          std::find(scale_limited.begin(), scale_limited.end(), i) != scale_limited.end();
       undetermined +=
-          (undetermined.empty() ? "" : ", ") + std::string(kParameterNames[i]) + ": " + kNeeds[i];
+          (undetermined.empty() ? "" : ", ") + std::string(kParameterNames[i]) + ": " +
+          (by_scale || i >= 3 ? "limited by the odometry's scale uncertainty" : kNeeds[i]);
     }
     status.add("not determined by the motion", undetermined.empty() ? "-" : undetermined);
     if (!undetermined.empty()) reasons.push_back(undetermined);
@@ -245,6 +250,12 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
       level = DiagnosticStatus::ERROR;
       reasons.push_back("non-finite estimate");
     }
+  }
+  // The camera-odometry time offset (issue 15), when it is estimated.
+  if (have_estimate_ && estimate_.time_offset_sigma > 0.0) {
+    status.add("odometry time offset [ms]", std::to_string(estimate_.time_offset * 1e3) + " +- " +
+                                                std::to_string(estimate_.time_offset_sigma * 1e3) +
+                                                " (odometry clock minus camera clock, 1 sigma)");
   }
   // Quality figures of the last processed pair (issue 16): values only, no level.
   if (have_estimate_ && quality_) {

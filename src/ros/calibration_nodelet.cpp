@@ -526,6 +526,10 @@ bool CalibrationNodelet::saveCalibration(std::string* error) {
     file.sigmas = last_estimate_->sigmas();
     file.covariance = last_estimate_->parameter_covariance;
     file.stamp = last_saved_stamp_.toSec();
+    if (last_estimate_->time_offset_sigma > 0.0) {
+      file.time_offset = last_estimate_->time_offset;
+      file.time_offset_sigma = last_estimate_->time_offset_sigma;
+    }
   }
   try {
     osc::writeCalibrationFileAtomic(config_.ros.calibration_file, file);

@@ -44,6 +44,8 @@ StereoCalibration makeCalibrationMessage(const osc::CalibrationEstimate& estimat
   }
   message.tracked_points = static_cast<uint32_t>(estimate.tracked_points);
   message.processing_time = processing_time;
+  message.time_offset = estimate.time_offset;
+  message.time_offset_sigma = estimate.time_offset_sigma;
   message.state = state;
   return message;
 }

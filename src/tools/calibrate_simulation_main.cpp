@@ -107,6 +107,8 @@ int main(int argc, char** argv) {
           e.sigmas = r.sigmas;
           e.tracked_points = r.tracked_points;
           e.time_ms = r.time_ms;
+          e.time_offset = r.time_offset;
+          e.time_offset_sigma = r.time_offset_sigma;
           estimates.write(e);
           estimate_rows.push_back(e);
           osc::ReferenceRow ref;
@@ -139,6 +141,10 @@ int main(int argc, char** argv) {
             osc::StereoExtrinsics::fromParameters(results.back().parameters);
         final_calibration.sigmas = results.back().sigmas;
         final_calibration.stamp = results.back().stamp;
+        if (results.back().time_offset_sigma > 0.0) {
+          final_calibration.time_offset = results.back().time_offset;
+          final_calibration.time_offset_sigma = results.back().time_offset_sigma;
+        }
         osc::writeCalibrationFileAtomic(options.out + "/calibration.yaml", final_calibration);
 
         std::sort(times.begin(), times.end());

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <random>
 
-#include <Eigen/Cholesky>
 #include <gtest/gtest.h>
+#include <Eigen/Cholesky>
 
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
 #include "online_stereo_calibration/core/filter/dense_calibration_ukf.h"
@@ -39,7 +39,8 @@ struct SmallProblem {
     }
     for (int k = 0; k < frames; ++k) {
       Vector6d w;
-      w << 0.35 * k, 0.0, 0.02 * std::sin(k), 0.03 * std::sin(0.7 * k), 0.03 * std::cos(0.9 * k), 0.02 * k;
+      w << 0.35 * k, 0.0, 0.02 * std::sin(k), 0.03 * std::sin(0.7 * k), 0.03 * std::cos(0.9 * k),
+          0.02 * k;
       T_world_veh.push_back(poseFromParameters(w));
     }
   }
@@ -53,7 +54,8 @@ struct SmallProblem {
 
   std::vector<PointMeasurement> measure(int k, double pixel_noise) {
     std::normal_distribution<double> n(0.0, pixel_noise);
-    const Eigen::Isometry3d T_lopt_world = (T_world_veh[k] * truth.vehicleToLeftOptical()).inverse();
+    const Eigen::Isometry3d T_lopt_world =
+        (T_world_veh[k] * truth.vehicleToLeftOptical()).inverse();
     const Eigen::Isometry3d T_ropt_lopt = truth.leftToRightOptical().inverse();
     std::vector<PointMeasurement> out;
     for (size_t i = 0; i < world.size(); ++i) {
@@ -70,20 +72,29 @@ struct SmallProblem {
 
 Matrix12d guessCovariance(double scale = 1.0) {
   Vector12d sigma;
-  sigma << 0.1, 0.1, 0.1, 2 * kDeg, 2 * kDeg, 2 * kDeg, 0.02, 0.02, 0.02, 0.3 * kDeg, 0.3 * kDeg, 0.3 * kDeg;
+  sigma << 0.1, 0.1, 0.1, 2 * kDeg, 2 * kDeg, 2 * kDeg, 0.02, 0.02, 0.02, 0.3 * kDeg, 0.3 * kDeg,
+      0.3 * kDeg;
   return (scale * sigma).array().square().matrix().asDiagonal();
+}
+
+/// The dense reference holds the calibration and the points only: no odometry states.
+FilterConfig configWithoutOdometryStates() {
+  FilterConfig config;
+  config.initial_time_offset_sigma = 0.0;
+  return config;
 }
 
 void expectFiltersAgree(MotionNoiseModel model) {
   SmallProblem problem(6, 6);
-  FilterConfig config;
+  FilterConfig config = configWithoutOdometryStates();
   config.motion_noise_model = model;
   CalibrationFilter structured(config, problem.K);
   DenseCalibrationUkf dense(config, problem.K);
   // A mildly nonlinear regime: the two filters linearise with different sigma-point
   // spreads (local 9-15 dimensions vs 2n+1 over all 30), which differ at second order.
   const Vector12d truth = problem.truth.toParameters();
-  problem.guess = StereoExtrinsics::fromParameters(truth + 0.05 * (problem.guess.toParameters() - truth));
+  problem.guess =
+      StereoExtrinsics::fromParameters(truth + 0.05 * (problem.guess.toParameters() - truth));
   structured.reset(problem.guess, guessCovariance(0.05));
   dense.reset(problem.guess, guessCovariance(0.05));
   for (const PointMeasurement& m : problem.measure(0, 0.3)) {
@@ -102,8 +113,10 @@ void expectFiltersAgree(MotionNoiseModel model) {
   const Matrix12d P = structured.covariance();
   const Matrix12d P_dense = dense.covariance().topLeftCorner<12, 12>();
   Vector12d difference;
-  difference.head<6>() = boxMinus(structured.extrinsics().T_veh_caml, dense.extrinsics().T_veh_caml);
-  difference.tail<6>() = boxMinus(structured.extrinsics().T_caml_camr, dense.extrinsics().T_caml_camr);
+  difference.head<6>() =
+      boxMinus(structured.extrinsics().T_veh_caml, dense.extrinsics().T_veh_caml);
+  difference.tail<6>() =
+      boxMinus(structured.extrinsics().T_caml_camr, dense.extrinsics().T_caml_camr);
   for (int k = 0; k < 12; ++k) {
     EXPECT_LT(std::abs(difference(k)), 0.1 * std::sqrt(P_dense(k, k))) << "parameter " << k;
     EXPECT_NEAR(std::sqrt(P(k, k)), std::sqrt(P_dense(k, k)), 0.05 * std::sqrt(P_dense(k, k))) << k;
@@ -124,15 +137,19 @@ void expectFiltersAgree(MotionNoiseModel model) {
   EXPECT_LT((full - dense.covariance()).norm(), 0.1 * dense.covariance().norm());
 }
 
-TEST(CalibrationFilter, AgreesWithDenseUkfPaperMotionNoise) { expectFiltersAgree(MotionNoiseModel::kPerPoint); }
-TEST(CalibrationFilter, AgreesWithDenseUkfSharedMotionNoise) { expectFiltersAgree(MotionNoiseModel::kShared); }
+TEST(CalibrationFilter, AgreesWithDenseUkfPaperMotionNoise) {
+  expectFiltersAgree(MotionNoiseModel::kPerPoint);
+}
+TEST(CalibrationFilter, AgreesWithDenseUkfSharedMotionNoise) {
+  expectFiltersAgree(MotionNoiseModel::kShared);
+}
 
 TEST(CalibrationFilter, NewPointCrossCovarianceMatchesMonteCarlo) {
   // Sec. II-A: the point's covariance and its cross-covariance with x_camr come out of the
   // SUT through triangulation. Check both against sampling the same inputs.
   SmallProblem problem(1, 1);
-  problem.world = {Eigen::Vector3d(7.0, 0.5, 1.0)};  // 5.5 m ahead: depth still near-Gaussian
-  FilterConfig config;
+  problem.world = {Eigen::Vector3d(7.0, 0.5, 1.0)};     // 5.5 m ahead: depth still near-Gaussian
+  FilterConfig config = configWithoutOdometryStates();  // the joint below is [12, point]
   CalibrationFilter filter(config, problem.K);
   filter.reset(problem.guess, guessCovariance());
   PointMeasurement m = problem.measure(0, 0.0).front();
@@ -187,7 +204,8 @@ class FilterWithPoints : public ::testing::Test {
   void expectUntouched(const CalibrationFilter& before) const {
     EXPECT_TRUE(filter.covariance() == before.covariance());
     EXPECT_TRUE(filter.extrinsics().T_veh_caml.matrix() == before.extrinsics().T_veh_caml.matrix());
-    EXPECT_TRUE(filter.extrinsics().T_caml_camr.matrix() == before.extrinsics().T_caml_camr.matrix());
+    EXPECT_TRUE(filter.extrinsics().T_caml_camr.matrix() ==
+                before.extrinsics().T_caml_camr.matrix());
     EXPECT_EQ(filter.pointCount(), before.pointCount());
   }
   void expectValid() const {

@@ -133,12 +133,35 @@ TEST(CalibrationFile, AtomicWriteThenReadIsBitExact) {
   for (int i = 0; i < 12; ++i) EXPECT_EQ((*read.sigmas)(i), (*written.sigmas)(i)) << i;
   ASSERT_TRUE(read.stamp.has_value());
   EXPECT_EQ(*read.stamp, *written.stamp);
+  EXPECT_FALSE(read.time_offset.has_value());  // only written when estimated
 
   const std::string text = readText(path);
   EXPECT_EQ(text.rfind("# ", 0), 0u) << "starts with a comment line";
   EXPECT_NE(text.find("metres and radians"), std::string::npos);
   EXPECT_NE(text.find("1.0000000000000001e-05"), std::string::npos) << text;
   EXPECT_EQ(dir.entries(), std::set<std::string>({"calibration.yaml"})) << "no temp file left";
+}
+
+TEST(CalibrationFile, TimeOffsetIsSavedAndReadBack) {
+  TempDir dir;
+  std::mt19937 rng(7);
+  CalibrationFile written = sampleCalibration(rng);
+  written.time_offset = -0.0123456789;
+  written.time_offset_sigma = 0.0004;
+  const std::string path = dir.file("calibration.yaml");
+  writeCalibrationFileAtomic(path, written);
+  const CalibrationFile read = readCalibrationFile(path);
+  ASSERT_TRUE(read.time_offset && read.time_offset_sigma);
+  EXPECT_EQ(*read.time_offset, *written.time_offset);
+  EXPECT_EQ(*read.time_offset_sigma, *written.time_offset_sigma);
+  expectThrowMentioning<std::runtime_error>(
+      [&] {
+        parseCalibrationYaml(
+            "vehicle_to_left: [0, 0, 0, 0, 0, 0]\nleft_to_right: [0, -0.5, 0, 0, 0, 0]\n"
+            "sigma_time_offset: -1\n",
+            "neg.yaml");
+      },
+      {"neg.yaml", "sigma_time_offset"});
 }
 
 TEST(CalibrationFile, FormattedTextParsesBackBitExactForManyValues) {
@@ -417,18 +440,19 @@ TEST(CalibrationFile, ReadOnlyDirectoryFailsCleanly) {
 // ---------------------------------------------------------------------------------------
 
 TEST(EstimatesCsv, HeaderIsExactlyTheInterface) {
-  const std::string interface_header =
+  const std::string interface_header = std::string(
       "frame,stamp,xl,yl,zl,roll_l,pitch_l,yaw_l,xr,yr,zr,roll_r,pitch_r,yaw_r,"
       "sigma_xl,sigma_yl,sigma_zl,sigma_roll_l,sigma_pitch_l,sigma_yaw_l,"
-      "sigma_xr,sigma_yr,sigma_zr,sigma_roll_r,sigma_pitch_r,sigma_yaw_r,tracked_points,time_ms";
-  EXPECT_EQ(estimatesCsvHeader(), interface_header);
+      "sigma_xr,sigma_yr,sigma_zr,sigma_roll_r,sigma_pitch_r,sigma_yaw_r,tracked_points,time_ms");
+  // interface.md allows further columns: the time offset (issue 15).
+  EXPECT_EQ(estimatesCsvHeader(), interface_header + ",time_offset_ms,sigma_time_offset_ms");
   EXPECT_EQ(referenceCsvHeader(),
             "frame,stamp,xl,yl,zl,roll_l,pitch_l,yaw_l,xr,yr,zr,roll_r,pitch_r,yaw_r");
 
   TempDir dir;
   { EstimatesCsvWriter writer(dir.file("estimates.csv")); }
   { ReferenceCsvWriter writer(dir.file("reference.csv")); }
-  EXPECT_EQ(readText(dir.file("estimates.csv")), interface_header + "\n");
+  EXPECT_EQ(readText(dir.file("estimates.csv")), estimatesCsvHeader() + "\n");
   EXPECT_EQ(readText(dir.file("reference.csv")), referenceCsvHeader() + "\n");
 }
 

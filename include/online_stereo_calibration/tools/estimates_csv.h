@@ -25,6 +25,10 @@ struct EstimateRow {
   Vector12d sigmas = Vector12d::Zero();      ///< 1-sigma of @ref parameters
   int tracked_points = 0;                    ///< points in the filter after the update
   double time_ms = 0;                        ///< processing time of this pair (ms)
+  /// Camera-odometry time offset estimate and its 1 sigma (s; 0 and 0: not estimated),
+  /// written as the further columns time_offset_ms, sigma_time_offset_ms.
+  double time_offset = 0;
+  double time_offset_sigma = 0;
 };
 
 /// One line of the reference (truth) CSV.
@@ -34,8 +38,10 @@ struct ReferenceRow {
   Vector12d parameters = Vector12d::Zero();  ///< true [xl..yaw_l, xr..yaw_r], m and rad
 };
 
-/// Column names of the estimates CSV, in order (interface.md).
+/// Column names of the estimates CSV, in order (interface.md); the reader requires these.
 const std::vector<std::string>& estimatesCsvColumns();
+/// The further columns the writer adds after them (interface.md allows more).
+const std::vector<std::string>& estimatesCsvFurtherColumns();
 /// Column names of the reference CSV, in order.
 const std::vector<std::string>& referenceCsvColumns();
 /// The header line (columns joined by ','), without newline.

@@ -119,6 +119,17 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "this (1 = as expected)"),
       integer("max_relinearizations", &C::max_relinearizations, 0, 1000,
               "restarts at most after one start or re-opening"),
+      real("initial_time_offset_ms", &C::initial_time_offset, 1e-3, -1000.0, 1000.0,
+           "prior mean of the odometry clock minus the camera clock"),
+      real("initial_time_offset_sigma_ms", &C::initial_time_offset_sigma, 1e-3, 0.0, 1000.0,
+           "prior 1 sigma of the camera-odometry time offset (0 = not estimated)"),
+      real("max_time_offset_ms", &C::max_time_offset, 1e-3, 0.0, 1000.0,
+           "the time offset's estimate is kept within +- this"),
+      real("time_offset_drift_ms", &C::time_offset_drift, 1e-3, 0.0, 1000.0,
+           "random walk of the time offset per reference step"),
+      real("odometry_scale_sigma_percent", &C::odometry_scale_sigma, 1e-2, 0.0, 50.0,
+           "1 sigma of the odometry's scale error, which images cannot tell: added to the "
+           "reported uncertainty of the translations (0 = the odometry's scale is exact)"),
       real("consistency_window_s", &C::consistency_window, 1.0, 0.0, 1e4,
            "window of the per-block score test of the updates' consistency (0 = off, as the "
            "paper; consistency_monitor.h)"),
@@ -149,6 +160,12 @@ std::vector<std::string> FilterConfig::validate() const {
       problems.push_back(message.str());
     }
   }
+  if (std::abs(initial_time_offset) > max_time_offset) {
+    std::ostringstream message;
+    message << "initial_time_offset_ms = " << initial_time_offset * 1e3
+            << " must lie within +- max_time_offset_ms = " << max_time_offset * 1e3;
+    problems.push_back(message.str());
+  }
   if (min_point_depth >= max_point_depth) {
     std::ostringstream message;
     message << "min_point_depth_m = " << min_point_depth
@@ -174,10 +191,12 @@ FilterConfig paperFilterConfig() {
   config.point_position_noise = 0.2;        // eq. 14
   config.camr_translation_drift = 0.01e-3;  // eq. 12
   config.motion_noise_model = MotionNoiseModel::kPerPoint;
-  config.motion_translation_noise = 0.0;  // "not considered in this paper"
-  config.motion_excitation_window = 0.0;  // the paper linearises at the measured motion
-  config.consistency_window = 0.0;        // the paper's random walk is fixed
-  config.relinearization_frames = 0;      // the paper's filter runs on from its start
+  config.motion_translation_noise = 0.0;   // "not considered in this paper"
+  config.motion_excitation_window = 0.0;   // the paper linearises at the measured motion
+  config.consistency_window = 0.0;         // the paper's random walk is fixed
+  config.relinearization_frames = 0;       // the paper's filter runs on from its start
+  config.initial_time_offset_sigma = 0.0;  // the paper takes the odometry as synchronised
+  config.odometry_scale_sigma = 0.0;       // ... and exact in scale
   return config;
 }
 

@@ -25,7 +25,25 @@ std::vector<int> undeterminedParameters(const CalibrationEstimate& estimate,
       undetermined.push_back(i);
     }
   }
+  for (int i : scaleLimitedParameters(estimate, thresholds)) {
+    if (std::find(undetermined.begin(), undetermined.end(), i) == undetermined.end())
+      undetermined.push_back(i);
+  }
+  std::sort(undetermined.begin(), undetermined.end());
   return undetermined;
+}
+
+std::vector<int> scaleLimitedParameters(const CalibrationEstimate& estimate,
+                                        const ConvergenceThresholds& thresholds) {
+  const Vector12d sigma = estimate.sigmas();
+  const Vector12d sigma_given_scale =
+      estimate.parameter_covariance_given_scale.diagonal().cwiseMax(0.0).cwiseSqrt();
+  std::vector<int> limited;
+  for (int i = 0; i < 12; ++i) {
+    const double bound = convergenceBound(thresholds, i);
+    if (!(3.0 * sigma(i) <= bound) && 3.0 * sigma_given_scale(i) <= bound) limited.push_back(i);
+  }
+  return limited;
 }
 
 bool isConverged(const CalibrationEstimate& estimate, const ConvergenceThresholds& thresholds) {

@@ -93,10 +93,12 @@ struct CalibrationFilter::Prediction {
   MotionIncrement motion;
   Eigen::Matrix3d R_excited;
   StereoExtrinsics extrinsics;
-  Matrix12d covariance;
+  MatrixXd covariance;
+  double time_offset = 0.0;
+  std::vector<MotionIncrement> previous_motions;
   std::vector<TrackedPoint> points;
   // Outputs.
-  Matrix12d predicted_covariance;
+  MatrixXd predicted_covariance;
   std::vector<TrackedPoint> predicted_points;
   MatrixXd P;
   std::vector<bool> failed;
@@ -126,6 +128,15 @@ bool samePoints(const std::vector<Point>& a, const std::vector<Point>& b) {
   return true;
 }
 
+bool samePreviousMotions(const std::vector<MotionIncrement>& a,
+                         const std::vector<MotionIncrement>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t k = 0; k < a.size(); ++k) {
+    if (a[k].dt != b[k].dt || a[k].T_prev_curr.matrix() != b[k].T_prev_curr.matrix()) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoIntrinsics& intrinsics)
@@ -144,7 +155,31 @@ CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoInt
   ut_.alpha = config.ut_alpha;
   ut_.beta = config.ut_beta;
   ut_.kappa = config.ut_kappa;
+  if (config.initial_time_offset_sigma > 0.0)
+    time_offset_index_ = layout::kOdometry + odometry_dim_++;
   reset(StereoExtrinsics());
+}
+
+MatrixXd CalibrationFilter::startCovariance(const Matrix12d& calibration) const {
+  MatrixXd P = MatrixXd::Zero(persistentDim(), persistentDim());
+  P.topLeftCorner<12, 12>() = calibration;
+  if (time_offset_index_ >= 0)
+    P(time_offset_index_, time_offset_index_) = std::pow(config_.initial_time_offset_sigma, 2);
+  return P;
+}
+
+void CalibrationFilter::motionModel(const MotionIncrement& motion, Eigen::Isometry3d* corrected,
+                                    MatrixXd* jacobian) const {
+  const MotionTwists twists = twistsAtEnds(previous_motions_, motion);
+  *corrected = correctedMotion(motion.T_prev_curr, time_offset_, twists);
+  jacobian->setZero(layout::kPoseDim, odometry_dim_);
+  if (time_offset_index_ < 0) return;
+  // Central differences over a step small against the offset's sigma; the model is smooth.
+  const double h = 1e-4;
+  const Eigen::Isometry3d plus = correctedMotion(motion.T_prev_curr, time_offset_ + h, twists);
+  const Eigen::Isometry3d minus = correctedMotion(motion.T_prev_curr, time_offset_ - h, twists);
+  jacobian->col(time_offset_index_ - layout::kOdometry) =
+      (boxMinus(plus, *corrected) - boxMinus(minus, *corrected)) / (2.0 * h);
 }
 
 void CalibrationFilter::reset(const StereoExtrinsics& guess) {
@@ -152,6 +187,7 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess) {
 }
 
 void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& covariance) {
+  last_prediction_.reset();
   if (!covariance.allFinite() ||
       (covariance - covariance.transpose()).cwiseAbs().maxCoeff() >
           1e-9 * covariance.cwiseAbs().maxCoeff() ||
@@ -160,7 +196,9 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& co
         "initial calibration covariance must be finite, symmetric and positive definite");
   }
   extrinsics_ = guess;
-  covariance_ = covariance;
+  covariance_ = startCovariance(covariance);
+  time_offset_ = config_.initial_time_offset;
+  previous_motions_.clear();
   excitation_.reset();
   monitor_.reset();
   points_.clear();
@@ -194,14 +232,18 @@ void CalibrationFilter::applyCalibrationDrift(double dt) {
   // g' = g + w (eq. 10-13). Each point is re-regressed on g' so that its marginal and its
   // cross-covariance with g' stay exact: B' = B P P'^-1, D' = D + B (P - P P'^-1 P) B^T.
   // The consistency monitor's factor per block (1 unless the block's measurements disagree).
-  Matrix12d drift = calibrationDriftCovariance(config_, dt);
+  MatrixXd drift = MatrixXd::Zero(persistentDim(), persistentDim());
+  drift.topLeftCorner<12, 12>() = calibrationDriftCovariance(config_, dt);
   drift.block<6, 6>(layout::kCaml, layout::kCaml) *=
       monitor_.inflation(ConsistencyBlock::kVehicleToLeft);
   drift.block<6, 6>(layout::kCamr, layout::kCamr) *=
       monitor_.inflation(ConsistencyBlock::kLeftToRight);
-  const Matrix12d P_next = covariance_ + drift;
-  const Matrix12d M = P_next.llt().solve(covariance_).transpose();  // P P'^-1
-  const Matrix12d forgotten = covariance_ - M * covariance_;
+  if (time_offset_index_ >= 0)
+    drift(time_offset_index_, time_offset_index_) =
+        std::pow(config_.time_offset_drift, 2) * noiseScale(config_, dt);
+  const MatrixXd P_next = covariance_ + drift;
+  const MatrixXd M = P_next.llt().solve(covariance_).transpose();  // P P'^-1
+  const MatrixXd forgotten = covariance_ - M * covariance_;
   for (TrackedPoint& point : points_) {
     point.D += point.B * forgotten * point.B.transpose();
     point.B = point.B * M;
@@ -211,19 +253,27 @@ void CalibrationFilter::applyCalibrationDrift(double dt) {
 
 void CalibrationFilter::predictPoints(const MotionIncrement& motion, const MatrixXd& P,
                                       std::vector<bool>* failed) {
-  // Seed eq. 7-8 through a UT on [x_caml, (motion error), p] per point (eq. 28).
+  // Seed eq. 7-8 through a UT on [x_caml, (odometry states), (motion error), p] per point
+  // (eq. 28). The odometry states act through the corrected motion, linearised once per
+  // step (motionModel: smooth, and their errors are small against the motion's).
   const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
   std::vector<int> selected = range(layout::kCaml, layout::kPoseDim);
+  const std::vector<int> odometry = range(layout::kOdometry, odometry_dim_);
+  selected.insert(selected.end(), odometry.begin(), odometry.end());
   if (shared) {
-    const std::vector<int> motion_block = range(layout::kMotion, layout::kPoseDim);
+    const std::vector<int> motion_block = range(persistentDim(), layout::kPoseDim);
     selected.insert(selected.end(), motion_block.begin(), motion_block.end());
   }
   const int s = static_cast<int>(selected.size());
+  Eigen::Isometry3d T_motion;
+  MatrixXd motion_jacobian;
+  motionModel(motion, &T_motion, &motion_jacobian);
+  const int o = odometry_dim_;
   const double sigma_p2 =
       config_.point_position_noise * config_.point_position_noise * noiseScale(config_, motion.dt);
   const double sigma_imu =
       config_.motion_rotation_noise * std::sqrt(noiseScale(config_, motion.dt));
-  const Eigen::Matrix3d R_excited = excitation_.excitedRotation(motion.T_prev_curr.linear());
+  const Eigen::Matrix3d R_excited = excitation_.excitedRotation(T_motion.linear());
 
   for (size_t i = 0; i < points_.size(); ++i) {
     TrackedPoint& point = points_[i];
@@ -231,8 +281,10 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
     const VectorFunction predict = [&](const VectorXd& x, VectorXd* y) {
       const Eigen::Isometry3d T_veh_lopt =
           boxPlus(extrinsics_.T_veh_caml, x.head<6>()) * bodyFromOptical();
-      const Eigen::Isometry3d T_prev_curr =
-          shared ? boxPlus(motion.T_prev_curr, x.segment<6>(6)) : motion.T_prev_curr;
+      Vector6d motion_error = Vector6d::Zero();
+      if (o > 0) motion_error = motion_jacobian * x.segment(6, o);
+      if (shared) motion_error += x.segment<6>(6 + o);
+      const Eigen::Isometry3d T_prev_curr = boxPlus(T_motion, motion_error);
       *y = predictPoint(mean + x.tail<3>(), T_veh_lopt, T_prev_curr, x.head<3>(), R_excited);
       return true;
     };
@@ -272,7 +324,7 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
   const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
   const int passes = shared ? 1 + config_.motion_relinearizations : 1;
   const std::vector<TrackedPoint> saved_points = passes > 1 ? points_ : std::vector<TrackedPoint>();
-  const Matrix12d saved_covariance = covariance_;
+  const MatrixXd saved_covariance = covariance_;
   MotionIncrement linearization = motion;
   Vector6d prior_motion_error = Vector6d::Zero();
   for (int pass = 0; pass < passes; ++pass) {
@@ -290,6 +342,9 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
     linearization.T_prev_curr = boxPlus(linearization.T_prev_curr, estimated_motion_error);
     prior_motion_error = boxMinus(motion.T_prev_curr, linearization.T_prev_curr);
   }
+  previous_motions_.push_back(motion);
+  if (static_cast<int>(previous_motions_.size()) > kTwistTrendIncrements)
+    previous_motions_.erase(previous_motions_.begin());
   if (report.jump != JumpBlock::kNone) monitor_.clearWindow();  // the evidence was the jump's
   monitor_.addUpdate(motion.dt, has_scores_ ? &scores_ : nullptr);
   report.consistency = monitor_.status();
@@ -430,6 +485,10 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   // ---- apply the correction on the manifold; drop the step's motion error ----
   extrinsics_.T_veh_caml = boxPlus(extrinsics_.T_veh_caml, dg.segment<6>(layout::kCaml));
   extrinsics_.T_caml_camr = boxPlus(extrinsics_.T_caml_camr, dg.segment<6>(layout::kCamr));
+  if (time_offset_index_ >= 0) {
+    time_offset_ = std::clamp(time_offset_ + dg(time_offset_index_), -config_.max_time_offset,
+                              config_.max_time_offset);
+  }
   if (shared) {
     marginalizeMotionError(P);
   } else {
@@ -457,7 +516,9 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
         last->R_excited == R_excited &&
         last->extrinsics.T_veh_caml.matrix() == extrinsics_.T_veh_caml.matrix() &&
         last->extrinsics.T_caml_camr.matrix() == extrinsics_.T_caml_camr.matrix() &&
-        last->covariance == covariance_ && samePoints(last->points, points_)) {
+        last->covariance == covariance_ && last->time_offset == time_offset_ &&
+        samePreviousMotions(last->previous_motions, previous_motions_) &&
+        samePoints(last->points, points_)) {
       covariance_ = last->predicted_covariance;
       points_ = last->predicted_points;
       *failed = last->failed;
@@ -471,6 +532,8 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
   prediction->R_excited = R_excited;
   prediction->extrinsics = extrinsics_;
   prediction->covariance = covariance_;
+  prediction->time_offset = time_offset_;
+  prediction->previous_motions = previous_motions_;
   prediction->points = points_;
   const MatrixXd P = predictAnew(motion, failed);
   prediction->predicted_covariance = covariance_;
@@ -484,9 +547,9 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
 MatrixXd CalibrationFilter::predictAnew(const MotionIncrement& motion, std::vector<bool>* failed) {
   applyCalibrationDrift(motion.dt);
   const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
-  const int G = shared ? layout::kAugmentedDim : layout::kCalibrationDim;
+  const int G = persistentDim() + (shared ? layout::kPoseDim : 0);
   MatrixXd P = MatrixXd::Zero(G, G);
-  P.topLeftCorner<12, 12>() = covariance_;
+  P.topLeftCorner(persistentDim(), persistentDim()) = covariance_;
   if (shared) {
     P.bottomRightCorner<6, 6>() = motionNoiseCovariance(config_, motion.dt);
     for (TrackedPoint& point : points_) {
@@ -589,14 +652,15 @@ void CalibrationFilter::marginalizeMotionError(const MatrixXd& P) {
   // Regress every point on the calibration alone: B = B_c + B_m P_mc P_cc^-1 and
   // D += B_m (P_mm - P_mc P_cc^-1 P_cm) B_m^T. Exact per point; the small common part left
   // by the step's motion error is not kept between points.
-  const Matrix12d P_cc = P.topLeftCorner<12, 12>();
-  const Eigen::Matrix<double, 6, 12> P_mc = P.bottomLeftCorner<6, 12>();
-  const Eigen::Matrix<double, 6, 12> regression = P_cc.llt().solve(P_mc.transpose()).transpose();
+  const int n = persistentDim();
+  const MatrixXd P_cc = P.topLeftCorner(n, n);
+  const MatrixXd P_mc = P.bottomLeftCorner(6, n);
+  const MatrixXd regression = P_cc.llt().solve(P_mc.transpose()).transpose();
   const Matrix6d conditional = P.bottomRightCorner<6, 6>() - regression * P_mc.transpose();
   for (TrackedPoint& point : points_) {
-    if (point.B.cols() != layout::kAugmentedDim) continue;
+    if (point.B.cols() != n + layout::kPoseDim) continue;
     const Eigen::Matrix<double, 3, 6> B_m = point.B.rightCols<6>();
-    const Eigen::Matrix<double, 3, 12> B_c = point.B.leftCols<12>() + B_m * regression;
+    const MatrixXd B_c = point.B.leftCols(n) + B_m * regression;
     point.D += B_m * conditional * B_m.transpose();
     point.B = B_c;
   }
@@ -704,7 +768,7 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
   TrackedPoint point;
   point.id = m.id;
   point.mean = ut.mean;
-  point.B = MatrixXd::Zero(3, layout::kCalibrationDim);
+  point.B = MatrixXd::Zero(3, persistentDim());
   point.B.middleCols<6>(layout::kCamr) = ut.jacobian.leftCols<6>();
   // D = Cov(p) - B P B^T: what the calibration does not explain (pixel noise, nonlinearity).
   MatrixXd D = ut.covariance - point.B * covariance_ * point.B.transpose();
@@ -725,7 +789,7 @@ void CalibrationFilter::removePoint(PointId id) {
 
 Matrix12d CalibrationFilter::parameterCovariance() const {
   const Matrix12d J = parameterJacobian(extrinsics_);
-  return J * covariance_ * J.transpose();
+  return J * covariance() * J.transpose();
 }
 
 std::vector<PointEstimate> CalibrationFilter::points() const {
@@ -742,16 +806,17 @@ std::vector<PointEstimate> CalibrationFilter::points() const {
 }
 
 MatrixXd CalibrationFilter::denseCovariance() const {
-  const int n = 12 + 3 * static_cast<int>(points_.size());
+  const int g = persistentDim();
+  const int n = g + 3 * static_cast<int>(points_.size());
   MatrixXd full = MatrixXd::Zero(n, n);
-  full.topLeftCorner<12, 12>() = covariance_;
+  full.topLeftCorner(g, g) = covariance_;
   for (size_t i = 0; i < points_.size(); ++i) {
-    const int a = 12 + 3 * static_cast<int>(i);
+    const int a = g + 3 * static_cast<int>(i);
     const MatrixXd BP = points_[i].B * covariance_;
-    full.block(a, 0, 3, 12) = BP;
-    full.block(0, a, 12, 3) = BP.transpose();
+    full.block(a, 0, 3, g) = BP;
+    full.block(0, a, g, 3) = BP.transpose();
     for (size_t j = 0; j < points_.size(); ++j) {
-      const int b = 12 + 3 * static_cast<int>(j);
+      const int b = g + 3 * static_cast<int>(j);
       full.block(a, b, 3, 3) = BP * points_[j].B.transpose();
     }
     full.block(a, a, 3, 3) += points_[i].D;

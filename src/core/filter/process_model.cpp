@@ -24,6 +24,48 @@ Eigen::Vector3d predictPoint(const Eigen::Vector3d& point_lopt, const Eigen::Iso
          T_veh_lopt.linear().transpose() * (lever_change * position_error);
 }
 
+MotionTwists twistsAtEnds(const std::vector<MotionIncrement>& earlier,
+                          const MotionIncrement& current) {
+  MotionTwists twists;
+  if (current.has_twists) {
+    twists.start = current.twist_start;
+    twists.end = current.twist_end;
+    return twists;
+  }
+  const int n = static_cast<int>(earlier.size());
+  if (n < 2) {
+    twists.start = twists.end = logSE3(current.T_prev_curr) / current.dt;
+    return twists;
+  }
+  // Each mean twist belongs to the middle of its interval; time 0 = the start of `current`.
+  std::vector<double> times(n);
+  std::vector<Vector6d> means(n);
+  double end = 0.0, time_mean = 0.0;
+  Vector6d twist_mean = Vector6d::Zero();
+  for (int k = n - 1; k >= 0; --k) {
+    times[k] = end - 0.5 * earlier[k].dt;
+    end -= earlier[k].dt;
+    means[k] = logSE3(earlier[k].T_prev_curr) / earlier[k].dt;
+    time_mean += times[k] / n;
+    twist_mean += means[k] / n;
+  }
+  double sxx = 0.0;
+  Vector6d sxy = Vector6d::Zero();
+  for (int k = 0; k < n; ++k) {
+    sxx += (times[k] - time_mean) * (times[k] - time_mean);
+    sxy += (times[k] - time_mean) * (means[k] - twist_mean);
+  }
+  const Vector6d rate = sxy / sxx;
+  twists.start = twist_mean - rate * time_mean;
+  twists.end = twists.start + rate * current.dt;
+  return twists;
+}
+
+Eigen::Isometry3d correctedMotion(const Eigen::Isometry3d& measured, double time_offset,
+                                  const MotionTwists& twists) {
+  return expSE3(twists.start * time_offset) * measured * expSE3(-twists.end * time_offset);
+}
+
 double noiseScale(const FilterConfig& config, double dt) { return dt / config.reference_period; }
 
 Matrix12d calibrationDriftCovariance(const FilterConfig& config, double dt) {

@@ -1,5 +1,9 @@
 #include "online_stereo_calibration/core/geometry/pose.h"
 
+#include <cmath>
+
+#include <Eigen/LU>
+
 #include "online_stereo_calibration/core/geometry/rotation.h"
 
 namespace osc {
@@ -41,6 +45,33 @@ Vector6d boxMinus(const Eigen::Isometry3d& pose, const Eigen::Isometry3d& refere
   delta.head<3>() = pose.translation() - reference.translation();
   delta.tail<3>() = logSO3(reference.linear().transpose() * pose.linear());
   return delta;
+}
+
+namespace {
+
+/// Left Jacobian of SO(3): V(w) = I + (1 - cos a) / a^2 [w]x + (a - sin a) / a^3 [w]x^2.
+Eigen::Matrix3d leftJacobianSO3(const Eigen::Vector3d& w) {
+  const double a = w.norm();
+  const Eigen::Matrix3d W = skew(w);
+  if (a < 1e-6) return Eigen::Matrix3d::Identity() + 0.5 * W + W * W / 6.0;
+  return Eigen::Matrix3d::Identity() + (1.0 - std::cos(a)) / (a * a) * W +
+         (a - std::sin(a)) / (a * a * a) * W * W;
+}
+
+}  // namespace
+
+Eigen::Isometry3d expSE3(const Vector6d& twist) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = expSO3(twist.tail<3>());
+  pose.translation() = leftJacobianSO3(twist.tail<3>()) * twist.head<3>();
+  return pose;
+}
+
+Vector6d logSE3(const Eigen::Isometry3d& pose) {
+  Vector6d twist;
+  twist.tail<3>() = logSO3(pose.linear());
+  twist.head<3>() = leftJacobianSO3(twist.tail<3>()).inverse() * pose.translation();
+  return twist;
 }
 
 StereoExtrinsics StereoExtrinsics::fromParameters(const Vector12d& parameters) {

@@ -137,6 +137,11 @@ bool MeasurementSimulator::nextFrame(SimulatedFrame* frame) {
     const double offset = scenario_.odometry_error.time_offset;
     if (offset != 0.0) reported.T_prev_curr = trueMotion(previous + offset, out.stamp + offset);
     out.measured_motion = perturbMotion(odometry_error_.apply(reported));
+    // The odometry's twists at both ends, on its clock and in its scale (exact derivatives:
+    // their noise matters to the time-offset model only times the offset).
+    out.measured_motion.has_twists = true;
+    out.measured_motion.twist_start = measuredTwist(previous + offset);
+    out.measured_motion.twist_end = measuredTwist(out.stamp + offset);
   }
   if (scenario_.isBlindFrame(out.index)) {
     // Nothing can be tracked: every track is lost, none is born (no random draws either).
@@ -153,6 +158,13 @@ bool MeasurementSimulator::nextFrame(SimulatedFrame* frame) {
   birthTracks(view, &out);
   *frame = std::move(out);
   return true;
+}
+
+Vector6d MeasurementSimulator::measuredTwist(double t) const {
+  constexpr double h = 1e-3;  // s, central difference of the true pose
+  Vector6d twist = logSE3(trueMotion(t - h, t + h)) / (2.0 * h);
+  twist.head<3>() *= 1.0 + scenario_.odometry_error.scale_error;
+  return twist;
 }
 
 MotionIncrement MeasurementSimulator::perturbMotion(const MotionIncrement& truth) {

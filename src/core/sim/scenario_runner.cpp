@@ -27,6 +27,8 @@ ScenarioFrameResult makeFrameResult(const SimulatedFrame& frame,
   r.jump_detected = report.step.jump != JumpBlock::kNone;
   r.converged = isConverged(estimate, ConvergenceThresholds());
   r.time_ms = time_ms;
+  r.time_offset = estimate.time_offset;
+  r.time_offset_sigma = estimate.time_offset_sigma;
   return r;
 }
 

@@ -26,6 +26,8 @@ constexpr const char* kLeftToRight = "left_to_right";
 constexpr const char* kSigmaVehicleToLeft = "sigma_vehicle_to_left";
 constexpr const char* kSigmaLeftToRight = "sigma_left_to_right";
 constexpr const char* kStamp = "stamp";
+constexpr const char* kTimeOffset = "time_offset";
+constexpr const char* kSigmaTimeOffset = "sigma_time_offset";
 constexpr const char* kCovariance = "covariance";
 
 [[noreturn]] void fail(const std::string& source, const std::string& what) {
@@ -153,6 +155,11 @@ CalibrationFile parseCalibrationYaml(const std::string& text, const std::string&
     file.sigmas = sigmas;
   }
   if (root[kStamp]) file.stamp = readNumber(root[kStamp], source_name, kStamp);
+  if (root[kTimeOffset]) file.time_offset = readNumber(root[kTimeOffset], source_name, kTimeOffset);
+  if (root[kSigmaTimeOffset]) {
+    file.time_offset_sigma = readNumber(root[kSigmaTimeOffset], source_name, kSigmaTimeOffset);
+    if (*file.time_offset_sigma < 0.0) fail(source_name, "key 'sigma_time_offset' is negative");
+  }
   if (root[kCovariance]) file.covariance = readCovariance(root, source_name, file.sigmas);
   return file;
 }
@@ -178,6 +185,8 @@ std::string formatCalibrationYaml(const CalibrationFile& file) {
   const Vector12d p = file.extrinsics.toParameters();
   if (!p.allFinite() || (file.sigmas && !file.sigmas->allFinite()) ||
       (file.stamp && !std::isfinite(*file.stamp)) ||
+      (file.time_offset && !std::isfinite(*file.time_offset)) ||
+      (file.time_offset_sigma && !std::isfinite(*file.time_offset_sigma)) ||
       (file.covariance && !file.covariance->allFinite())) {
     throw std::runtime_error("calibration: refusing to write NaN or infinite values");
   }
@@ -193,6 +202,12 @@ std::string formatCalibrationYaml(const CalibrationFile& file) {
     text += std::string(kSigmaLeftToRight) + ": " + formatList(file.sigmas->tail<6>()) + "\n";
   }
   if (file.stamp) text += std::string(kStamp) + ": " + formatNumber(*file.stamp) + "\n";
+  if (file.time_offset) {
+    text += std::string(kTimeOffset) + ": " + formatNumber(*file.time_offset) +
+            "  # s, odometry clock minus camera clock (estimated)\n";
+  }
+  if (file.time_offset_sigma)
+    text += std::string(kSigmaTimeOffset) + ": " + formatNumber(*file.time_offset_sigma) + "\n";
   if (file.covariance) {
     // One flow list over 12 lines, a row of the matrix per line.
     text += std::string(kCovariance) +

@@ -33,6 +33,8 @@ CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& o
     e.sigmas = r.sigmas;
     e.tracked_points = r.tracked_points;
     e.time_ms = r.time_ms;
+    e.time_offset = r.time_offset;
+    e.time_offset_sigma = r.time_offset_sigma;
     estimates.write(e);
     ReferenceRow ref;
     ref.frame = r.frame;

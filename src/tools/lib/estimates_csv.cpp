@@ -169,6 +169,11 @@ const std::vector<std::string>& estimatesCsvColumns() {
   return columns;
 }
 
+const std::vector<std::string>& estimatesCsvFurtherColumns() {
+  static const std::vector<std::string> columns = {"time_offset_ms", "sigma_time_offset_ms"};
+  return columns;
+}
+
 const std::vector<std::string>& referenceCsvColumns() {
   static const std::vector<std::string> columns = [] {
     std::vector<std::string> c = {"frame", "stamp"};
@@ -178,7 +183,9 @@ const std::vector<std::string>& referenceCsvColumns() {
   return columns;
 }
 
-std::string estimatesCsvHeader() { return join(estimatesCsvColumns()); }
+std::string estimatesCsvHeader() {
+  return join(estimatesCsvColumns()) + ',' + join(estimatesCsvFurtherColumns());
+}
 
 std::string referenceCsvHeader() { return join(referenceCsvColumns()); }
 
@@ -190,7 +197,9 @@ void EstimatesCsvWriter::write(const EstimateRow& row) {
   out_ << row.frame << ',' << formatStamp(row.stamp);
   for (int i = 0; i < 12; ++i) out_ << ',' << formatValue(row.parameters(i));
   for (int i = 0; i < 12; ++i) out_ << ',' << formatValue(row.sigmas(i));
-  out_ << ',' << row.tracked_points << ',' << formatValue(row.time_ms) << '\n';
+  out_ << ',' << row.tracked_points << ',' << formatValue(row.time_ms) << ','
+       << formatValue(row.time_offset * 1e3) << ',' << formatValue(row.time_offset_sigma * 1e3)
+       << '\n';
   checkStream(out_, path_);
 }
 

@@ -262,6 +262,8 @@ int evaluateBag(const Options& options) {
     row.sigmas = result.estimate.sigmas();
     row.tracked_points = static_cast<int>(result.estimate.tracked_points);
     row.time_ms = 1000.0 * result.processing_time;
+    row.time_offset = result.estimate.time_offset;
+    row.time_offset_sigma = result.estimate.time_offset_sigma;
     estimates_csv.write(row);
     estimates.push_back(row);
     times.push_back(row.time_ms);
@@ -296,6 +298,10 @@ int evaluateBag(const Options& options) {
   final_calibration.extrinsics = osc::StereoExtrinsics::fromParameters(estimates.back().parameters);
   final_calibration.sigmas = estimates.back().sigmas;
   final_calibration.stamp = estimates.back().stamp;
+  if (estimates.back().time_offset_sigma > 0.0) {
+    final_calibration.time_offset = estimates.back().time_offset;
+    final_calibration.time_offset_sigma = estimates.back().time_offset_sigma;
+  }
   osc::writeCalibrationFileAtomic(options.out + "/calibration.yaml", final_calibration);
 
   const osc::Percentiles timing = osc::percentiles(times);

@@ -102,6 +102,26 @@ struct FilterConfig {
   /// ... at most this many times after one start or re-opening.
   int max_relinearizations = 4;
 
+  // --- the odometry's own errors as states (issue 15; process_model.h correctedMotion) ---
+  /// Prior mean (s) of the camera-odometry time offset: the odometry's clock minus the
+  /// cameras' (the odometry stamps a motion `time_offset` later than the cameras see it).
+  double initial_time_offset = 0.0;
+  /// Prior 1 sigma (s) of that offset; 0 = not estimated (the offset is taken as the prior
+  /// mean). 10 ms at 10 m/s moves the camera 10 cm between what the odometry and the images
+  /// say, which x_caml's translation absorbs if the offset is not a state.
+  double initial_time_offset_sigma = 0.02;
+  /// s: the estimate is kept within +- this (a larger offset is a configuration error).
+  double max_time_offset = 0.2;
+  /// s per reference step: random walk of the offset (clock drift).
+  double time_offset_drift = 1e-5;
+  /// 1 sigma of the odometry's scale error kappa (measured translation = (1 + kappa) x
+  /// true). Images and odometry together cannot tell it: scaling every translation (the
+  /// vehicle's, both cameras', the points') by 1 + kappa leaves every pixel where it was, so
+  /// the baseline's metric length is the odometry's. The filter estimates in the odometry's
+  /// scale; the reported covariance adds what kappa leaves open, kappa^2 t t^T over the
+  /// translations t (StereoCalibrationEstimator::estimate). 0 = the odometry's scale is exact.
+  double odometry_scale_sigma = 0.01;
+
   // --- consistency monitor and adaptive drift noise (consistency_monitor.h) ---
   /// Sliding window (s) of the per-block score test of the updates; 0 = off (the paper).
   double consistency_window = 4.0;

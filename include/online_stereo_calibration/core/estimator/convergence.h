@@ -22,12 +22,18 @@ struct ConvergenceThresholds {
 /// The 3-sigma bound of parameter @p index (interface order).
 double convergenceBound(const ConvergenceThresholds& thresholds, int index);
 
-/// The parameters (interface order) the current motion does not determine, so that their
-/// sigma may stay wide without blocking convergence: x_caml translations along a vehicle
-/// axis whose two other axes have not rotated beyond the motion noise lately
-/// (unexcitedTranslationAxes of estimate.excitation) and whose 3-sigma is above its bound
-/// (a parameter already learned is not excused).
+/// The parameters (interface order) the data do not determine, so that their sigma may stay
+/// wide without blocking convergence: x_caml translations along a vehicle axis whose two
+/// other axes have not rotated beyond the motion noise lately (unexcitedTranslationAxes of
+/// estimate.excitation) and whose 3-sigma is above its bound (a parameter already learned
+/// is not excused); and scaleLimitedParameters().
 std::vector<int> undeterminedParameters(const CalibrationEstimate& estimate,
+                                        const ConvergenceThresholds& thresholds);
+
+/// The translations whose 3-sigma is above its bound only because of the odometry's scale
+/// uncertainty (FilterConfig::odometry_scale_sigma), which no drive reduces: within the
+/// bound as if the scale were exact (CalibrationEstimate::parameter_covariance_given_scale).
+std::vector<int> scaleLimitedParameters(const CalibrationEstimate& estimate,
                                         const ConvergenceThresholds& thresholds);
 
 /// Every parameter's 3-sigma within its bound, undeterminedParameters() excepted.

@@ -21,6 +21,13 @@ struct MotionIncrement {
   Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();
   /// Time between the two image pairs (s); > 0.
   double dt = 0.1;
+  /// The vehicle's body twist [v (3), w (3)] (m/s, rad/s, vehicle frame) at the start and at
+  /// the end of the increment as the odometry measured it, if it did (has_twists). The
+  /// time-offset model needs how the motion changes (process_model.h twistsAtEnds); without
+  /// them it is taken from the earlier increments.
+  bool has_twists = false;
+  Eigen::Matrix<double, 6, 1> twist_start = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> twist_end = Eigen::Matrix<double, 6, 1>::Zero();
 };
 
 /// One point seen in both images of a stereo pair.

@@ -13,6 +13,8 @@
 /// points marginalised. Memory and time O(N) instead of O(N^2) / O(N^3).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -25,6 +27,7 @@
 #include "online_stereo_calibration/core/filter/consistency_monitor.h"
 #include "online_stereo_calibration/core/filter/measurement_model.h"
 #include "online_stereo_calibration/core/filter/motion_excitation.h"
+#include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/filter/unscented_transform.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 
@@ -80,9 +83,11 @@ class CalibrationFilter {
   /// @throws std::invalid_argument listing every invalid config value.
   CalibrationFilter(const FilterConfig& config, const StereoIntrinsics& intrinsics);
 
-  /// Starts over from a guess with the config's initial sigmas; removes every point.
+  /// Starts over from a guess with the config's initial sigmas; removes every point. The
+  /// odometry states (the time offset) start from their priors too.
   void reset(const StereoExtrinsics& guess);
-  /// Starts over from a guess with the given tangent covariance (see covariance()).
+  /// Starts over from a guess with the given tangent covariance (see covariance()); the
+  /// odometry states start from their priors.
   /// @throws std::invalid_argument if the covariance is not finite, symmetric PD.
   void reset(const StereoExtrinsics& guess, const Matrix12d& covariance);
 
@@ -113,12 +118,18 @@ class CalibrationFilter {
 
   const StereoExtrinsics& extrinsics() const { return extrinsics_; }
   /// Covariance of the tangent error [dt_l, dtheta_l, dt_r, dtheta_r] (pose.h boxPlus).
-  const Matrix12d& covariance() const { return covariance_; }
+  Matrix12d covariance() const { return covariance_.topLeftCorner<12, 12>(); }
   /// Covariance of the interface's 12 parameters (RPY), by first-order propagation.
   Matrix12d parameterCovariance() const;
+
+  /// The camera-odometry time offset state (FilterConfig::initial_time_offset_sigma;
+  /// process_model.h correctedMotion): odometry clock minus camera clock (s), and its 1 sigma
+  /// (0 when not estimated).
+  double timeOffset() const { return time_offset_; }
+  double timeOffsetSigma() const { return stateSigma(time_offset_index_); }
   std::vector<PointEstimate> points() const;
-  /// The full (12 + 3N)^2 covariance the structured form represents, points in the order
-  /// of points(). For tests and diagnostics; O(N^2).
+  /// The full (P + 3N)^2 covariance the structured form represents (P = 12 + the odometry
+  /// states), points in the order of points(). For tests and diagnostics; O(N^2).
   Eigen::MatrixXd denseCovariance() const;
 
   /// The consistency monitor's state: per-block statistics and the drift-noise factors.
@@ -138,6 +149,17 @@ class CalibrationFilter {
   struct Prediction;       // defined in the .cpp
 
   std::string checkMotion(const MotionIncrement& motion) const;
+  /// Size of the persistent global error: calibration (12) + odometry states.
+  int persistentDim() const { return layout::kCalibrationDim + odometry_dim_; }
+  double stateSigma(int index) const {
+    return index < 0 ? 0.0 : std::sqrt(std::max(covariance_(index, index), 0.0));
+  }
+  /// The start covariance: @p calibration and the odometry state's prior, uncorrelated.
+  Eigen::MatrixXd startCovariance(const Matrix12d& calibration) const;
+  /// The step's vehicle motion at the current odometry states, and its derivative (boxPlus
+  /// tangent) with respect to them (6 x odometry_dim_).
+  void motionModel(const MotionIncrement& motion, Eigen::Isometry3d* corrected,
+                   Eigen::MatrixXd* jacobian) const;
   /// One predict + update linearised at `motion` with the given prior mean of the motion
   /// error; a non-final pass only estimates the motion error. False: a jump was detected
   /// (the step is complete then).
@@ -168,11 +190,20 @@ class CalibrationFilter {
   void rebuildIndex();
 
   FilterConfig config_;
+  /// The odometry states in the global error after the calibration (state_layout.h
+  /// kOdometry): how many, and where each is (-1: not estimated).
+  int odometry_dim_ = 0;
+  int time_offset_index_ = -1;
+  double time_offset_ = 0.0;  ///< s, odometry clock minus camera clock
+  /// The last accepted motion increments since the last reset, oldest first, at most
+  /// kTwistTrendIncrements (twistsAtEnds).
+  std::vector<MotionIncrement> previous_motions_;
   MotionExcitation excitation_;
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;
   StereoExtrinsics extrinsics_;
-  Matrix12d covariance_ = Matrix12d::Identity();
+  /// Covariance of the persistent global error [calibration (12), odometry states].
+  Eigen::MatrixXd covariance_;
   std::vector<TrackedPoint> points_;
   std::unordered_map<PointId, size_t> index_;
   /// The last predictObservations' prediction: the step that follows, with the same motion

@@ -36,6 +36,14 @@ Eigen::Isometry3d boxPlus(const Eigen::Isometry3d& pose, const Vector6d& delta);
 /// Inverse of boxPlus: the delta with boxPlus(reference, delta) == pose.
 Vector6d boxMinus(const Eigen::Isometry3d& pose, const Eigen::Isometry3d& reference);
 
+/// The group exponential of SE(3): the pose reached after a unit time at the constant body
+/// twist [v (3), w (3)] (velocity and angular rate in the moving frame):
+/// R = Exp(w), t = V(w) v (V: the left Jacobian of SO(3)).
+Eigen::Isometry3d expSE3(const Vector6d& twist);
+
+/// Inverse of expSE3 (rotation angle below pi).
+Vector6d logSE3(const Eigen::Isometry3d& pose);
+
 /// The two extrinsic transforms the package estimates (seed eq. 1-2, interface.md).
 struct StereoExtrinsics {
   /// x_caml: pose of the left camera *body* frame in the vehicle frame.

@@ -86,6 +86,8 @@ class MeasurementSimulator {
   /// True motion T_veh(t0)_veh(t1) = truePose(t0)^-1 * truePose(t1); exactly the identity
   /// while the vehicle stands in a stop.
   Eigen::Isometry3d trueMotion(double t0, double t1) const;
+  /// The body twist [v, w] the odometry reports at its time t (true, times its scale error).
+  Vector6d measuredTwist(double t) const;
   /// The vehicle's world x-y positions over the drive [0, frames / rate_hz] (clamped to the
   /// recording), for SceneConfig::path of the image-level renderer: at most 1 m apart for
   /// the analytic profile (the scene decimates to 1 m), every recorded pose in between for a

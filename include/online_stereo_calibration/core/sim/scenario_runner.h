@@ -31,6 +31,9 @@ struct ScenarioFrameResult {
   /// isConverged(estimate, ConvergenceThresholds()) after this frame (convergence.h).
   bool converged = false;
   double time_ms = 0.0;  ///< estimator time for this frame
+  /// Estimated camera-odometry time offset and its 1 sigma (s; sigma 0: not estimated).
+  double time_offset = 0.0;
+  double time_offset_sigma = 0.0;
 };
 
 /// One frame's result from the estimate after it, the truth and the estimator's report.
