@@ -81,6 +81,7 @@ Matrix12d guessCovariance(double scale = 1.0) {
 FilterConfig configWithoutOdometryStates() {
   FilterConfig config;
   config.initial_time_offset_sigma = 0.0;
+  config.odometry_velocity_bias_sigma = 0.0;
   return config;
 }
 

@@ -127,6 +127,11 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "the time offset's estimate is kept within +- this"),
       real("time_offset_drift_ms", &C::time_offset_drift, 1e-3, 0.0, 1000.0,
            "random walk of the time offset per reference step"),
+      real("odometry_velocity_bias_sigma_mps", &C::odometry_velocity_bias_sigma, 1.0, 0.0, 10.0,
+           "steady-state 1 sigma of a slowly varying odometry velocity error, estimated per "
+           "vehicle axis (0 = not estimated)"),
+      real("odometry_bias_correlation_time_s", &C::odometry_bias_correlation_time, 1.0, 0.1, 1e6,
+           "correlation time of that velocity error (first-order Gauss-Markov)"),
       real("odometry_scale_sigma_percent", &C::odometry_scale_sigma, 1e-2, 0.0, 50.0,
            "1 sigma of the odometry's scale error, which images cannot tell: added to the "
            "reported uncertainty of the translations (0 = the odometry's scale is exact)"),
@@ -191,12 +196,13 @@ FilterConfig paperFilterConfig() {
   config.point_position_noise = 0.2;        // eq. 14
   config.camr_translation_drift = 0.01e-3;  // eq. 12
   config.motion_noise_model = MotionNoiseModel::kPerPoint;
-  config.motion_translation_noise = 0.0;   // "not considered in this paper"
-  config.motion_excitation_window = 0.0;   // the paper linearises at the measured motion
-  config.consistency_window = 0.0;         // the paper's random walk is fixed
-  config.relinearization_frames = 0;       // the paper's filter runs on from its start
-  config.initial_time_offset_sigma = 0.0;  // the paper takes the odometry as synchronised
-  config.odometry_scale_sigma = 0.0;       // ... and exact in scale
+  config.motion_translation_noise = 0.0;      // "not considered in this paper"
+  config.motion_excitation_window = 0.0;      // the paper linearises at the measured motion
+  config.consistency_window = 0.0;            // the paper's random walk is fixed
+  config.relinearization_frames = 0;          // the paper's filter runs on from its start
+  config.initial_time_offset_sigma = 0.0;     // the paper takes the odometry as synchronised
+  config.odometry_scale_sigma = 0.0;          // ... and exact in scale
+  config.odometry_velocity_bias_sigma = 0.0;  // ... and without a velocity error
   return config;
 }
 

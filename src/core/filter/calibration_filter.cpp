@@ -18,6 +18,14 @@ using Eigen::VectorXd;
 
 namespace {
 
+/// The vehicle axes whose velocity error is a state: lateral and vertical. A forward error
+/// at a steady speed is a scale error, which images cannot tell (filter_config.h
+/// odometry_scale_sigma): as a state it would take spurious information from linearisation
+/// and move the baseline with it (measured: clean drives 25 -> 20 of 50 honest, yr). The
+/// vertical one matters most (lateral only: campaign C_odometry 17 -> 4 of 50 honest).
+constexpr int kVelocityBiasAxes = 2;
+constexpr int kVelocityBiasAxis[kVelocityBiasAxes] = {1, 2};
+
 /// chi-square(2) at 99.9 %: the left image's share of a stereo innovation.
 constexpr double kLeftGate = 13.82;
 
@@ -95,10 +103,12 @@ struct CalibrationFilter::Prediction {
   StereoExtrinsics extrinsics;
   MatrixXd covariance;
   double time_offset = 0.0;
+  Eigen::Vector3d velocity_bias = Eigen::Vector3d::Zero();
   std::vector<MotionIncrement> previous_motions;
   std::vector<TrackedPoint> points;
   // Outputs.
   MatrixXd predicted_covariance;
+  Eigen::Vector3d predicted_velocity_bias = Eigen::Vector3d::Zero();
   std::vector<TrackedPoint> predicted_points;
   MatrixXd P;
   std::vector<bool> failed;
@@ -157,6 +167,10 @@ CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoInt
   ut_.kappa = config.ut_kappa;
   if (config.initial_time_offset_sigma > 0.0)
     time_offset_index_ = layout::kOdometry + odometry_dim_++;
+  if (config.odometry_velocity_bias_sigma > 0.0) {
+    velocity_bias_index_ = layout::kOdometry + odometry_dim_;
+    odometry_dim_ += kVelocityBiasAxes;
+  }
   reset(StereoExtrinsics());
 }
 
@@ -165,21 +179,51 @@ MatrixXd CalibrationFilter::startCovariance(const Matrix12d& calibration) const 
   P.topLeftCorner<12, 12>() = calibration;
   if (time_offset_index_ >= 0)
     P(time_offset_index_, time_offset_index_) = std::pow(config_.initial_time_offset_sigma, 2);
+  for (int k = 0; velocity_bias_index_ >= 0 && k < kVelocityBiasAxes; ++k) {
+    P(velocity_bias_index_ + k, velocity_bias_index_ + k) =
+        std::pow(config_.odometry_velocity_bias_sigma, 2);
+  }
   return P;
+}
+
+Eigen::Vector3d CalibrationFilter::velocityBiasSigma() const {
+  Eigen::Vector3d sigma = Eigen::Vector3d::Zero();
+  for (int k = 0; velocity_bias_index_ >= 0 && k < kVelocityBiasAxes; ++k) {
+    sigma(kVelocityBiasAxis[k]) =
+        std::sqrt(std::max(covariance_(velocity_bias_index_ + k, velocity_bias_index_ + k), 0.0));
+  }
+  return sigma;
 }
 
 void CalibrationFilter::motionModel(const MotionIncrement& motion, Eigen::Isometry3d* corrected,
                                     MatrixXd* jacobian) const {
   const MotionTwists twists = twistsAtEnds(previous_motions_, motion);
-  *corrected = correctedMotion(motion.T_prev_curr, time_offset_, twists);
+  // The measured translation is t + b dt (b: velocity error), then the time offset.
+  const auto model = [&](double time_offset, const Eigen::Vector3d& velocity_bias) {
+    Eigen::Isometry3d unbiased = motion.T_prev_curr;
+    unbiased.translation() -= velocity_bias * motion.dt;
+    return correctedMotion(unbiased, time_offset, twists);
+  };
+  *corrected = model(time_offset_, velocity_bias_);
   jacobian->setZero(layout::kPoseDim, odometry_dim_);
-  if (time_offset_index_ < 0) return;
-  // Central differences over a step small against the offset's sigma; the model is smooth.
-  const double h = 1e-4;
-  const Eigen::Isometry3d plus = correctedMotion(motion.T_prev_curr, time_offset_ + h, twists);
-  const Eigen::Isometry3d minus = correctedMotion(motion.T_prev_curr, time_offset_ - h, twists);
-  jacobian->col(time_offset_index_ - layout::kOdometry) =
-      (boxMinus(plus, *corrected) - boxMinus(minus, *corrected)) / (2.0 * h);
+  // Central differences over steps small against the states' sigmas; the model is smooth.
+  if (time_offset_index_ >= 0) {
+    const double h = 1e-4;
+    jacobian->col(time_offset_index_ - layout::kOdometry) =
+        (boxMinus(model(time_offset_ + h, velocity_bias_), *corrected) -
+         boxMinus(model(time_offset_ - h, velocity_bias_), *corrected)) /
+        (2.0 * h);
+  }
+  if (velocity_bias_index_ >= 0) {
+    const double h = 1e-3;
+    for (int k = 0; k < kVelocityBiasAxes; ++k) {
+      const Eigen::Vector3d step = h * Eigen::Vector3d::Unit(kVelocityBiasAxis[k]);
+      jacobian->col(velocity_bias_index_ - layout::kOdometry + k) =
+          (boxMinus(model(time_offset_, velocity_bias_ + step), *corrected) -
+           boxMinus(model(time_offset_, velocity_bias_ - step), *corrected)) /
+          (2.0 * h);
+    }
+  }
 }
 
 void CalibrationFilter::reset(const StereoExtrinsics& guess) {
@@ -198,6 +242,7 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& co
   extrinsics_ = guess;
   covariance_ = startCovariance(covariance);
   time_offset_ = config_.initial_time_offset;
+  velocity_bias_.setZero();
   previous_motions_.clear();
   excitation_.reset();
   monitor_.reset();
@@ -229,9 +274,10 @@ std::string CalibrationFilter::checkMotion(const MotionIncrement& m) const {
 }
 
 void CalibrationFilter::applyCalibrationDrift(double dt) {
-  // g' = g + w (eq. 10-13). Each point is re-regressed on g' so that its marginal and its
-  // cross-covariance with g' stay exact: B' = B P P'^-1, D' = D + B (P - P P'^-1 P) B^T.
-  // The consistency monitor's factor per block (1 unless the block's measurements disagree).
+  // g' = F g + w (eq. 10-13; F = I but for the velocity error's Gauss-Markov decay). Each
+  // point is re-regressed on g' so that its marginal and its cross-covariance with g' stay
+  // exact: B' = B P F^T P'^-1, D' = D + B (P - P F^T P'^-1 F P) B^T. The consistency
+  // monitor's factor per block (1 unless the block's measurements disagree).
   MatrixXd drift = MatrixXd::Zero(persistentDim(), persistentDim());
   drift.topLeftCorner<12, 12>() = calibrationDriftCovariance(config_, dt);
   drift.block<6, 6>(layout::kCaml, layout::kCaml) *=
@@ -241,9 +287,20 @@ void CalibrationFilter::applyCalibrationDrift(double dt) {
   if (time_offset_index_ >= 0)
     drift(time_offset_index_, time_offset_index_) =
         std::pow(config_.time_offset_drift, 2) * noiseScale(config_, dt);
-  const MatrixXd P_next = covariance_ + drift;
-  const MatrixXd M = P_next.llt().solve(covariance_).transpose();  // P P'^-1
-  const MatrixXd forgotten = covariance_ - M * covariance_;
+  MatrixXd F = MatrixXd::Identity(persistentDim(), persistentDim());
+  if (velocity_bias_index_ >= 0) {
+    const double decay = std::exp(-dt / config_.odometry_bias_correlation_time);
+    for (int k = 0; k < kVelocityBiasAxes; ++k) {
+      const int i = velocity_bias_index_ + k;
+      F(i, i) = decay;
+      drift(i, i) = std::pow(config_.odometry_velocity_bias_sigma, 2) * (1.0 - decay * decay);
+    }
+    velocity_bias_ *= decay;
+  }
+  const MatrixXd FP = F * covariance_;
+  const MatrixXd P_next = FP * F.transpose() + drift;
+  const MatrixXd M = P_next.llt().solve(FP).transpose();  // P F^T P'^-1
+  const MatrixXd forgotten = covariance_ - M * FP;
   for (TrackedPoint& point : points_) {
     point.D += point.B * forgotten * point.B.transpose();
     point.B = point.B * M;
@@ -325,12 +382,14 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
   const int passes = shared ? 1 + config_.motion_relinearizations : 1;
   const std::vector<TrackedPoint> saved_points = passes > 1 ? points_ : std::vector<TrackedPoint>();
   const MatrixXd saved_covariance = covariance_;
+  const Eigen::Vector3d saved_velocity_bias = velocity_bias_;
   MotionIncrement linearization = motion;
   Vector6d prior_motion_error = Vector6d::Zero();
   for (int pass = 0; pass < passes; ++pass) {
     if (pass > 0) {
       points_ = saved_points;
       covariance_ = saved_covariance;
+      velocity_bias_ = saved_velocity_bias;
       report = StepReport();
     }
     Vector6d estimated_motion_error;
@@ -489,6 +548,8 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
     time_offset_ = std::clamp(time_offset_ + dg(time_offset_index_), -config_.max_time_offset,
                               config_.max_time_offset);
   }
+  for (int k = 0; velocity_bias_index_ >= 0 && k < kVelocityBiasAxes; ++k)
+    velocity_bias_(kVelocityBiasAxis[k]) += dg(velocity_bias_index_ + k);
   if (shared) {
     marginalizeMotionError(P);
   } else {
@@ -517,9 +578,11 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
         last->extrinsics.T_veh_caml.matrix() == extrinsics_.T_veh_caml.matrix() &&
         last->extrinsics.T_caml_camr.matrix() == extrinsics_.T_caml_camr.matrix() &&
         last->covariance == covariance_ && last->time_offset == time_offset_ &&
+        last->velocity_bias == velocity_bias_ &&
         samePreviousMotions(last->previous_motions, previous_motions_) &&
         samePoints(last->points, points_)) {
       covariance_ = last->predicted_covariance;
+      velocity_bias_ = last->predicted_velocity_bias;
       points_ = last->predicted_points;
       *failed = last->failed;
       last_prediction_ = last;  // its measurement UTs, for linearizeMeasurement
@@ -533,10 +596,12 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
   prediction->extrinsics = extrinsics_;
   prediction->covariance = covariance_;
   prediction->time_offset = time_offset_;
+  prediction->velocity_bias = velocity_bias_;
   prediction->previous_motions = previous_motions_;
   prediction->points = points_;
   const MatrixXd P = predictAnew(motion, failed);
   prediction->predicted_covariance = covariance_;
+  prediction->predicted_velocity_bias = velocity_bias_;
   prediction->predicted_points = points_;
   prediction->P = P;
   prediction->failed = *failed;

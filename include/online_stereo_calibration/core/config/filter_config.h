@@ -114,6 +114,19 @@ struct FilterConfig {
   double max_time_offset = 0.2;
   /// s per reference step: random walk of the offset (clock drift).
   double time_offset_drift = 1e-5;
+  /// Steady-state 1 sigma (m/s, per vehicle axis) of a slowly varying additive error of the
+  /// odometry's velocity (wheel slip, a tilted or drifting IMU): a first-order Gauss-Markov
+  /// state b with correlation time odometry_bias_correlation_time; the measured translation
+  /// over dt is t + b dt. 0 = not estimated. A lateral bias at low speed turns the motion's
+  /// direction, which x_caml's rotation would otherwise absorb. Only the lateral and the
+  /// vertical error are states (a forward one is a scale error: odometry_scale_sigma).
+  /// Off by default: it costs the information that makes zl (camera height) observable at
+  /// all (paper_offroad zl RMSE 12 -> 23 mm, above the paper's Table I) while making drives
+  /// with such errors honest far more often (docs/RESULTS.md "Odometry errors": campaign
+  /// C_odometry 4 -> 17 of 50 runs). Turn it on (e.g. 0.01) for odometry known to drift.
+  double odometry_velocity_bias_sigma = 0.0;
+  /// s, correlation time of that bias.
+  double odometry_bias_correlation_time = 30.0;
   /// 1 sigma of the odometry's scale error kappa (measured translation = (1 + kappa) x
   /// true). Images and odometry together cannot tell it: scaling every translation (the
   /// vehicle's, both cameras', the points') by 1 + kappa leaves every pixel where it was, so
