@@ -77,14 +77,15 @@ simulator_sources=(src/core/sim include/online_stereo_calibration/core/sim
   src/tools/lib/tum_trajectory.cpp include/online_stereo_calibration/tools/scenario_file.h
   include/online_stereo_calibration/tools/drive_simulation.h
   include/online_stereo_calibration/tools/tum_trajectory.h
-  src/tools/ros/simulate_main.cpp src/tools/ros/bag_io.h)
+  src/tools/ros/simulate_main.cpp src/tools/ros/bag_io.h
+  msg)  # the bag's ground truth is a StereoCalibration: a new field is a new message type
 stamp_of_drive() {
   {
     echo "frames $frames"
     sha256sum "$scenario" | cut -d' ' -f1
     for source in "${simulator_sources[@]}"; do
       if [[ -e "$source" ]]; then
-        find "$source" -type f \( -name '*.cpp' -o -name '*.h' \) -print0 |
+        find "$source" -type f \( -name '*.cpp' -o -name '*.h' -o -name '*.msg' \) -print0 |
           sort -z | xargs -0 -r sha256sum | cut -d' ' -f1
       fi
     done

@@ -36,6 +36,8 @@ struct KittiRun {
   /// The estimator restarted from its current estimate at this pair (re-linearised, tracks
   /// reset: FilterConfig::relinearization_*).
   std::vector<bool> restarted;
+  /// The estimated camera-odometry time offset and its sigma (s).
+  std::vector<double> time_offsets, time_offset_sigmas;
 };
 
 KittiRun runKitti(const KittiSequence& sequence, const Vector12d& start_error,
@@ -60,6 +62,8 @@ KittiRun runKitti(const KittiSequence& sequence, const Vector12d& start_error,
     run.sigmas.push_back(r.estimate.sigmas());
     run.points.push_back(static_cast<int>(r.estimate.tracked_points));
     run.restarted.push_back(r.estimator.relinearized);
+    run.time_offsets.push_back(r.estimate.time_offset);
+    run.time_offset_sigmas.push_back(r.estimate.time_offset_sigma);
   }
   return run;
 }
@@ -124,9 +128,10 @@ TEST(Kitti, DISABLED_Diagnostic) {
       const Vector12d& s = run.sigmas[k];
       std::printf(
           "%s %2zu pts %3d | xl %+.3f(%.3f) yl %+.3f(%.3f) zl %+.3f(%.3f) yaw_l %+.3f(%.3f) | yr "
-          "%+.4f(%.4f) roll_r %+.3f(%.3f) pitch_r %+.3f(%.3f) yaw_r %+.3f(%.3f)\n",
+          "%+.4f(%.4f) roll_r %+.3f(%.3f) pitch_r %+.3f(%.3f) yaw_r %+.3f(%.3f) | dt %+.1f(%.1f) ms\n",
           seq, k, run.points[k], e(0), s(0), e(1), s(1), e(2), s(2), e(5) / kDeg, s(5) / kDeg, e(7),
-          s(7), e(9) / kDeg, s(9) / kDeg, e(10) / kDeg, s(10) / kDeg, e(11) / kDeg, s(11) / kDeg);
+          s(7), e(9) / kDeg, s(9) / kDeg, e(10) / kDeg, s(10) / kDeg, e(11) / kDeg, s(11) / kDeg,
+          run.time_offsets[k] * 1e3, run.time_offset_sigmas[k] * 1e3);
     }
   }
 }
