@@ -70,6 +70,22 @@ LookupStatus PoseBuffer::poseAt(double stamp, Eigen::Isometry3d* pose) const {
   return LookupStatus::kOk;
 }
 
+bool PoseBuffer::incrementCovariance(double from, double to,
+                                     Eigen::Matrix<double, 6, 6>* covariance) const {
+  if (samples_.size() < 2 || !(to > from) || from < samples_.front().stamp ||
+      to > samples_.back().stamp) {
+    return false;
+  }
+  covariance->setZero();
+  for (size_t i = 1; i < samples_.size(); ++i) {
+    const double overlap = std::min(to, samples_[i].stamp) - std::max(from, samples_[i - 1].stamp);
+    if (overlap <= 0.0) continue;
+    if (!samples_[i].has_twist_covariance) return false;
+    *covariance += samples_[i].twist_covariance * (overlap * overlap);
+  }
+  return true;
+}
+
 bool GyroIntegrator::add(double stamp, const Eigen::Vector3d& angular_rate) {
   if (!std::isfinite(stamp) || !angular_rate.allFinite()) return false;
   if (!samples_.empty() && !(stamp > samples_.back().stamp)) return false;

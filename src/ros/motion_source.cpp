@@ -29,6 +29,24 @@ void MotionSource::odomCallback(const nav_msgs::Odometry::ConstPtr& message) {
     return;
   }
   StampedPose sample{message->header.stamp.toSec(), isometryFromPose(message->pose.pose)};
+  if (config_.use_odometry_covariance) {
+    // Usable: finite, symmetric, non-negative variances and not all zero (many drivers
+    // leave it zero, or mark it unknown with -1). Else no covariance for this sample.
+    Eigen::Matrix<double, 6, 6> c;
+    for (int r = 0; r < 6; ++r)
+      for (int k = 0; k < 6; ++k)
+        c(r, k) = message->twist.covariance[static_cast<size_t>(6 * r + k)];
+    const bool usable = c.allFinite() && c.diagonal().minCoeff() >= 0.0 &&
+                        c.diagonal().maxCoeff() > 0.0 &&
+                        (c - c.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * c.cwiseAbs().maxCoeff();
+    sample.has_twist_covariance = usable;
+    if (usable) sample.twist_covariance = c;
+    if (!usable && on_problem) {
+      on_problem("unusable odometry covariance",
+                 "twist covariance not finite, negative, asymmetric or all zero: the configured "
+                 "motion noise is used for this interval");
+    }
+  }
   PoseBuffer::Offered offered;
   double newest = 0.0;
   {
@@ -118,6 +136,13 @@ LookupStatus MotionSource::motionBetween(const ros::Time& previous, const ros::T
   if (status != LookupStatus::kOk) return status;
   motion->T_prev_curr = pose_previous.inverse() * pose_current;
   motion->dt = (current - previous).toSec();
+  motion->has_covariance = false;
+  if (config_.use_odometry_covariance && config_.motion_source == MotionSourceType::kOdom &&
+      !config_.use_imu) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    motion->has_covariance =
+        poses_.incrementCovariance(previous.toSec(), current.toSec(), &motion->covariance);
+  }
   if (config_.use_imu) {
     Eigen::Matrix3d rotation;
     std::lock_guard<std::mutex> lock(mutex_);

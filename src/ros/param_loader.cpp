@@ -155,6 +155,7 @@ RosConfig loadRosConfig(const ros::NodeHandle& nh, std::vector<std::string>* pro
   }
   readString(nh, "fixed_frame", &config.fixed_frame, problems);
   readBool(nh, "use_imu", &config.use_imu, problems);
+  readBool(nh, "use_odometry_covariance", &config.use_odometry_covariance, problems);
   readNumber(nh, "motion_history", &config.motion_history, problems);
   readNumber(nh, "max_motion_gap", &config.max_motion_gap, problems);
   readNumber(nh, "motion_wait", &config.motion_wait, problems);

@@ -247,6 +247,39 @@ TEST_F(FilterWithPoints, AbsurdMotionIsRejectedAndStateUntouched) {
   expectUntouched(before);
 }
 
+TEST_F(FilterWithPoints, BadMotionCovarianceIsRejectedAndStateUntouched) {
+  const CalibrationFilter before = filter;
+  MotionIncrement m = problem.motion(4);
+  m.has_covariance = true;
+  m.covariance = -1e-4 * Matrix6d::Identity();  // "unknown" as some drivers say it
+  StepReport report = filter.step(m, problem.measure(4, 0.5));
+  EXPECT_FALSE(report.accepted);
+  EXPECT_NE(report.message.find("motion covariance"), std::string::npos) << report.message;
+  m.covariance = Matrix6d::Identity();
+  m.covariance(0, 1) = 0.5;  // not symmetric
+  EXPECT_FALSE(filter.step(m, problem.measure(4, 0.5)).accepted);
+  m.covariance(0, 1) = std::nan("");
+  EXPECT_FALSE(filter.step(m, problem.measure(4, 0.5)).accepted);
+  expectUntouched(before);
+}
+
+TEST_F(FilterWithPoints, TheOdometrysOwnCovarianceReplacesTheConfiguredMotionNoise) {
+  // A larger stated motion error leaves the points' predicted positions less certain, and
+  // the configured one is what a motion without covariance gets.
+  const MotionIncrement plain = problem.motion(4);
+  MotionIncrement stated = plain;
+  stated.has_covariance = true;
+  stated.covariance = motionNoiseCovariance(filter.config(), plain.dt);
+  const auto spread = [&](const MotionIncrement& m) {
+    double trace = 0.0;
+    for (const PredictedObservation& p : filter.predictObservations(m)) trace += p.S.trace();
+    return trace;
+  };
+  EXPECT_NEAR(spread(stated), spread(plain), 1e-9 * spread(plain));
+  stated.covariance *= 100.0;
+  EXPECT_GT(spread(stated), 1.5 * spread(plain));
+}
+
 TEST_F(FilterWithPoints, NanMeasurementIsIgnoredAndCounted) {
   auto measurements = problem.measure(4, 0.5);
   measurements[3].z(2) = std::numeric_limits<double>::infinity();

@@ -66,6 +66,32 @@ TEST(PoseBuffer, InterpolatesAtImageStampsAndReportsWhy) {
   EXPECT_EQ(buffer.poseAt(2.0, &pose), LookupStatus::kGap);
 }
 
+// Issue 15: the increment's covariance from the odometry's twist covariances.
+TEST(PoseBuffer, IncrementCovarianceSumsTheTwistCovariancesOverTheInterval) {
+  PoseBuffer buffer(10.0, 0.5);
+  Eigen::Matrix<double, 6, 6> twist = Eigen::Matrix<double, 6, 6>::Zero();
+  twist.diagonal() << 0.04, 0.01, 0.01, 1e-4, 1e-4, 4e-4;  // (0.2 m/s)^2 ... (0.02 rad/s)^2
+  for (int i = 0; i <= 10; ++i) {
+    StampedPose sample{1.0 + 0.02 * i, truthAt(1.0 + 0.02 * i)};
+    sample.has_twist_covariance = true;
+    sample.twist_covariance = twist;
+    ASSERT_TRUE(buffer.add(sample));
+  }
+  Eigen::Matrix<double, 6, 6> covariance;
+  // 0.1 s = 5 whole samples of 0.02 s: 5 * C * 0.02^2.
+  ASSERT_TRUE(buffer.incrementCovariance(1.02, 1.12, &covariance));
+  EXPECT_LT((covariance - 5.0 * 0.0004 * twist).cwiseAbs().maxCoeff(), 1e-15);
+  // Partial overlaps count by their length: [1.01, 1.03] = two halves of 0.01 s.
+  ASSERT_TRUE(buffer.incrementCovariance(1.01, 1.03, &covariance));
+  EXPECT_LT((covariance - 2.0 * 0.0001 * twist).cwiseAbs().maxCoeff(), 1e-15);
+  // Beyond the samples, or over a sample without covariance: none.
+  EXPECT_FALSE(buffer.incrementCovariance(1.1, 1.3, &covariance));
+  StampedPose bare{1.22, truthAt(1.22)};
+  ASSERT_TRUE(buffer.add(bare));
+  EXPECT_FALSE(buffer.incrementCovariance(1.1, 1.21, &covariance));
+  EXPECT_TRUE(buffer.incrementCovariance(1.1, 1.2, &covariance));
+}
+
 // Issue 17: one stale odometry message must not wipe the history; a time line that really
 // went back (a bag loop) is adopted after PoseBuffer::kSamplesToRestart samples.
 TEST(PoseBuffer, OneStaleSampleIsRefusedButANewTimeLineIsAdopted) {
@@ -330,6 +356,23 @@ TEST(CalibrationState, UndeterminedTranslationsDoNotBlockConverged) {
   // Standing still: nothing rotates, but xl and yl, already learned, are not listed.
   estimate.excitation.setZero();
   EXPECT_EQ(osc::undeterminedParameters(estimate, bounds), std::vector<int>{2});
+}
+
+// Issue 15: what only the odometry's scale leaves open (the baseline's metric length) is
+// reported and does not block CONVERGED; the same width from the data themselves does.
+TEST(CalibrationState, WhatOnlyTheOdometrysScaleLeavesOpenDoesNotBlockConverged) {
+  osc::CalibrationEstimate estimate;
+  estimate.tracked_points = 50;
+  estimate.parameter_covariance = osc::Matrix12d::Identity() * 1e-8;
+  osc::ConvergenceThresholds bounds;
+  const double scale_variance = std::pow(0.01 * 0.5, 2);  // 1 % of a 0.5 m baseline
+  estimate.parameter_covariance(7, 7) += scale_variance;
+  estimate.odometry_scale_covariance(7, 7) = scale_variance;
+  EXPECT_EQ(osc::scaleLimitedParameters(estimate, bounds), std::vector<int>{7});
+  EXPECT_EQ(calibrationState(estimate, false, 10, bounds), StereoCalibration::STATE_CONVERGED);
+  estimate.odometry_scale_covariance.setZero();  // the same width, not from the scale
+  EXPECT_TRUE(osc::scaleLimitedParameters(estimate, bounds).empty());
+  EXPECT_EQ(calibrationState(estimate, false, 10, bounds), StereoCalibration::STATE_CONVERGING);
 }
 
 }  // namespace

@@ -59,6 +59,10 @@ std::string poseProblem(const geometry_msgs::Pose& pose);
 struct StampedPose {
   double stamp = 0.0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  /// The covariance of the twist [v, w] that led to this sample since the one before
+  /// (nav_msgs/Odometry twist.covariance, vehicle frame), when the odometry gives a usable one.
+  bool has_twist_covariance = false;
+  Eigen::Matrix<double, 6, 6> twist_covariance = Eigen::Matrix<double, 6, 6>::Zero();
 };
 
 /// The pose at @p stamp between @p before and @p after: translation linear, rotation SLERP

@@ -61,6 +61,13 @@ class PoseBuffer {
   /// The pose at @p stamp, interpolated between the two samples bracketing it.
   LookupStatus poseAt(double stamp, Eigen::Isometry3d* pose) const;
 
+  /// The covariance of the error of the motion increment between @p from and @p to, from
+  /// the samples' twist covariances: each sample's twist error is taken as constant over its
+  /// interval since the sample before and independent of the others', so an overlap of
+  /// length l with [from, to] adds C l^2. False if a sample that overlaps has none (or the
+  /// interval is not covered).
+  bool incrementCovariance(double from, double to, Eigen::Matrix<double, 6, 6>* covariance) const;
+
   bool empty() const { return samples_.empty(); }
   double newestStamp() const { return samples_.empty() ? 0.0 : samples_.back().stamp; }
 

@@ -40,9 +40,12 @@ struct RosConfig {
   MotionSourceType motion_source = MotionSourceType::kOdom;
   std::string fixed_frame = "odom";  ///< fixed frame for motion_source tf
   bool use_imu = false;              ///< rotation from `imu` angular rate, translation from odom/tf
-  double motion_history = 10.0;      ///< s of odometry / IMU kept
-  double max_motion_gap = 0.5;       ///< s, largest gap between bracketing motion samples
-  double motion_wait = 0.3;          ///< s to wait for a motion sample after an image pair
+  /// The motion noise of each increment from the odometry's twist covariances (motion_source
+  /// odom without use_imu; PoseBuffer::incrementCovariance) instead of the configured one.
+  bool use_odometry_covariance = false;
+  double motion_history = 10.0;  ///< s of odometry / IMU kept
+  double max_motion_gap = 0.5;   ///< s, largest gap between bracketing motion samples
+  double motion_wait = 0.3;      ///< s to wait for a motion sample after an image pair
 
   InitialGuessSource initial_guess_source = InitialGuessSource::kParameters;
   osc::Vector6d vehicle_to_left = osc::Vector6d::Zero();  ///< xl..yaw_l (m, rad)

@@ -37,11 +37,17 @@ std::vector<int> scaleLimitedParameters(const CalibrationEstimate& estimate,
                                         const ConvergenceThresholds& thresholds) {
   const Vector12d sigma = estimate.sigmas();
   const Vector12d sigma_given_scale =
-      estimate.parameter_covariance_given_scale.diagonal().cwiseMax(0.0).cwiseSqrt();
+      (estimate.parameter_covariance - estimate.odometry_scale_covariance)
+          .diagonal()
+          .cwiseMax(0.0)
+          .cwiseSqrt();
   std::vector<int> limited;
   for (int i = 0; i < 12; ++i) {
     const double bound = convergenceBound(thresholds, i);
-    if (!(3.0 * sigma(i) <= bound) && 3.0 * sigma_given_scale(i) <= bound) limited.push_back(i);
+    if (estimate.odometry_scale_covariance(i, i) > 0.0 && !(3.0 * sigma(i) <= bound) &&
+        3.0 * sigma_given_scale(i) <= bound) {
+      limited.push_back(i);
+    }
   }
   return limited;
 }

@@ -259,19 +259,19 @@ CalibrationEstimate StereoCalibrationEstimator::estimate() const {
   CalibrationEstimate e;
   e.extrinsics = filter_.extrinsics();
   e.parameters = e.extrinsics.toParameters();
-  e.parameter_covariance_given_scale = filter_.parameterCovariance();
   e.tangent_covariance = filter_.covariance();
+  e.parameter_covariance = filter_.parameterCovariance();
   if (config_.odometry_scale_sigma > 0.0) {
     // Scaling every translation by 1 + kappa explains the pixels as well (filter_config.h):
-    // the translations' tangent errors share kappa * t.
+    // the translations' tangent errors share kappa * t. Translations are parameters as they
+    // are (no Jacobian needed: their tangent and parameter coordinates agree).
     Vector12d t = Vector12d::Zero();
     t.segment<3>(layout::kCaml + layout::kTranslation) = e.extrinsics.T_veh_caml.translation();
     t.segment<3>(layout::kCamr + layout::kTranslation) = e.extrinsics.T_caml_camr.translation();
-    e.tangent_covariance += std::pow(config_.odometry_scale_sigma, 2) * t * t.transpose();
-    const Matrix12d J = parameterJacobian(e.extrinsics);
-    e.parameter_covariance = J * e.tangent_covariance * J.transpose();
-  } else {
-    e.parameter_covariance = e.parameter_covariance_given_scale;
+    const Matrix12d scale = std::pow(config_.odometry_scale_sigma, 2) * t * t.transpose();
+    e.tangent_covariance += scale;
+    e.parameter_covariance += scale;
+    e.odometry_scale_covariance = scale;
   }
   e.tracked_points = filter_.pointCount();
   e.excitation = filter_.excitationGains();

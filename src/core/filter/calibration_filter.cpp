@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 #include "online_stereo_calibration/core/filter/process_model.h"
@@ -138,6 +139,16 @@ bool samePoints(const std::vector<Point>& a, const std::vector<Point>& b) {
   return true;
 }
 
+bool motionCovarianceIsValid(const Matrix6d& covariance) {
+  if (!covariance.allFinite()) return false;
+  if ((covariance - covariance.transpose()).cwiseAbs().maxCoeff() >
+      1e-9 * std::max(covariance.cwiseAbs().maxCoeff(), 1e-300)) {
+    return false;
+  }
+  return Eigen::SelfAdjointEigenSolver<Matrix6d>(covariance).eigenvalues().minCoeff() >=
+         -1e-12 * covariance.cwiseAbs().maxCoeff();
+}
+
 bool samePreviousMotions(const std::vector<MotionIncrement>& a,
                          const std::vector<MotionIncrement>& b) {
   if (a.size() != b.size()) return false;
@@ -266,6 +277,8 @@ std::string CalibrationFilter::checkMotion(const MotionIncrement& m) const {
   } else if (m.T_prev_curr.translation().norm() > config_.max_speed * m.dt) {
     why << "motion of " << m.T_prev_curr.translation().norm() << " m in " << m.dt
         << " s exceeds max_speed_mps = " << config_.max_speed;
+  } else if (m.has_covariance && !motionCovarianceIsValid(m.covariance)) {
+    why << "motion covariance is not finite, symmetric and positive semi-definite";
   } else if (logSO3(R).norm() > config_.max_angular_rate * m.dt) {
     why << "rotation of " << logSO3(R).norm() * 180.0 / M_PI << " deg in " << m.dt
         << " s exceeds max_angular_rate_dps = " << config_.max_angular_rate * 180.0 / M_PI;
@@ -574,7 +587,11 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
   if (const std::shared_ptr<const Prediction> last = std::move(last_prediction_)) {
     if (last->motion.dt == motion.dt &&
         last->motion.T_prev_curr.matrix() == motion.T_prev_curr.matrix() &&
-        last->R_excited == R_excited &&
+        last->motion.has_covariance == motion.has_covariance &&
+        last->motion.covariance == motion.covariance &&
+        last->motion.has_twists == motion.has_twists &&
+        last->motion.twist_start == motion.twist_start &&
+        last->motion.twist_end == motion.twist_end && last->R_excited == R_excited &&
         last->extrinsics.T_veh_caml.matrix() == extrinsics_.T_veh_caml.matrix() &&
         last->extrinsics.T_caml_camr.matrix() == extrinsics_.T_caml_camr.matrix() &&
         last->covariance == covariance_ && last->time_offset == time_offset_ &&
@@ -616,7 +633,9 @@ MatrixXd CalibrationFilter::predictAnew(const MotionIncrement& motion, std::vect
   MatrixXd P = MatrixXd::Zero(G, G);
   P.topLeftCorner(persistentDim(), persistentDim()) = covariance_;
   if (shared) {
-    P.bottomRightCorner<6, 6>() = motionNoiseCovariance(config_, motion.dt);
+    // The odometry's own covariance of this increment when it gives one, else the model.
+    P.bottomRightCorner<6, 6>() =
+        motion.has_covariance ? motion.covariance : motionNoiseCovariance(config_, motion.dt);
     for (TrackedPoint& point : points_) {
       point.B.conservativeResize(3, G);
       point.B.rightCols<6>().setZero();

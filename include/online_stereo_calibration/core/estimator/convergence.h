@@ -32,7 +32,7 @@ std::vector<int> undeterminedParameters(const CalibrationEstimate& estimate,
 
 /// The translations whose 3-sigma is above its bound only because of the odometry's scale
 /// uncertainty (FilterConfig::odometry_scale_sigma), which no drive reduces: within the
-/// bound as if the scale were exact (CalibrationEstimate::parameter_covariance_given_scale).
+/// bound without it (CalibrationEstimate::odometry_scale_covariance).
 std::vector<int> scaleLimitedParameters(const CalibrationEstimate& estimate,
                                         const ConvergenceThresholds& thresholds);
 

@@ -35,9 +35,10 @@ struct CalibrationEstimate {
   /// camera clock (s), and its 1 sigma (0 = not estimated).
   double time_offset = 0.0;
   double time_offset_sigma = 0.0;
-  /// parameter_covariance as if the odometry's scale were exact: the difference is what
-  /// FilterConfig::odometry_scale_sigma leaves open (convergence.h does not wait for it).
-  Matrix12d parameter_covariance_given_scale = Matrix12d::Zero();
+  /// The part of parameter_covariance (and of tangent_covariance) that the odometry's scale
+  /// uncertainty adds (FilterConfig::odometry_scale_sigma; zero when 0): convergence.h does
+  /// not wait for it.
+  Matrix12d odometry_scale_covariance = Matrix12d::Zero();
 
   /// 1-sigma of each parameter (sqrt of the covariance diagonal).
   Vector12d sigmas() const { return parameter_covariance.diagonal().cwiseMax(0.0).cwiseSqrt(); }

@@ -28,6 +28,11 @@ struct MotionIncrement {
   bool has_twists = false;
   Eigen::Matrix<double, 6, 1> twist_start = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> twist_end = Eigen::Matrix<double, 6, 1>::Zero();
+  /// The covariance of this increment's error [dt (3), dtheta (3)] (pose.h boxPlus: m, rad)
+  /// as the odometry states it, if it does (has_covariance): the shared motion-noise model
+  /// then uses it instead of the configured motion noise. Symmetric positive semi-definite.
+  bool has_covariance = false;
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
 };
 
 /// One point seen in both images of a stereo pair.
