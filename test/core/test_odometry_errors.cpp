@@ -8,6 +8,7 @@
 
 #include "online_stereo_calibration/core/filter/process_model.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
+#include "online_stereo_calibration/core/sim/measurement_simulator.h"
 #include "online_stereo_calibration/core/sim/scenario_runner.h"
 #include "online_stereo_calibration/tools/campaign_score.h"
 
@@ -122,6 +123,38 @@ TEST(OdometryScale, TheTranslationsUncertaintyCoversAScaleErrorImagesCannotTell)
   exact_scale.odometry_scale_sigma = 0.0;
   const CampaignScore old = scoreCampaignRun(runMeasurementScenario(scenario, exact_scale));
   EXPECT_GT(old.max_z, 5.0);  // yr: the baseline in the odometry's (wrong) scale
+}
+
+}  // namespace
+}  // namespace osc
+
+namespace osc {
+namespace {
+
+// A saved calibration (estimate()'s covariance, scale included) restored by reset() comes back
+// as saved, not widened by the odometry's scale a second time; a prior sharper than the scale
+// allows comes back widened by it.
+TEST(OdometryScale, SaveAndRestoreGiveTheSavedCovarianceBack) {
+  MeasurementScenario scenario = offroadWithout(60);
+  MeasurementSimulator simulator(scenario);
+  StereoCalibrationEstimator estimator(FilterConfig(), scenario.left, scenario.right,
+                                       simulator.initialGuess());
+  SimulatedFrame frame;
+  while (simulator.nextFrame(&frame)) estimator.processFrame(frame.measured_motion, frame.observations);
+  const CalibrationEstimate saved = estimator.estimate();
+  ASSERT_GT(saved.odometry_scale_covariance(7, 7), 0.0);
+  estimator.reset(saved.extrinsics, saved.tangent_covariance);
+  const Matrix12d restored = estimator.estimate().tangent_covariance;
+  EXPECT_LE((restored - saved.tangent_covariance).cwiseAbs().maxCoeff(),
+            1e-12 * saved.tangent_covariance.cwiseAbs().maxCoeff());
+  // 1 mm on every translation: sharper than 1 % of a 1.5 m lever arm allows.
+  Matrix12d sharp = Matrix12d::Identity() * 1e-6;
+  estimator.reset(saved.extrinsics, sharp);
+  const CalibrationEstimate widened = estimator.estimate();
+  EXPECT_LE((widened.tangent_covariance - sharp - widened.odometry_scale_covariance)
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-15);
 }
 
 }  // namespace

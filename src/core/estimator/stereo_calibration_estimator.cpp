@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/Cholesky>
+
 namespace osc {
 namespace {
 
@@ -250,9 +252,29 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
                                        const Matrix12d& tangent_covariance) {
-  filter_.reset(guess, tangent_covariance);
+  // The given covariance is one as estimate() reports it (a saved calibration): take out what
+  // the odometry's scale adds there, so that save -> restore -> estimate() gives it back. If
+  // that leaves it indefinite (a prior sharper than the odometry's scale allows, e.g. sigmas
+  // only), the filter starts from it as given and reports it widened by the scale.
+  const Matrix12d scale = odometryScaleCovariance(guess);
+  const Matrix12d internal = tangent_covariance - scale;
+  filter_.reset(guess, scale.isZero() || internal.llt().info() != Eigen::Success
+                           ? tangent_covariance
+                           : Matrix12d(0.5 * (internal + internal.transpose())));
   has_previous_frame_ = false;
   anchorHere(JumpBlock::kNone, 0.0, 0.0);
+}
+
+Matrix12d StereoCalibrationEstimator::odometryScaleCovariance(
+    const StereoExtrinsics& extrinsics) const {
+  if (!(config_.odometry_scale_sigma > 0.0)) return Matrix12d::Zero();
+  // Scaling every translation by 1 + kappa explains the pixels as well (filter_config.h):
+  // the translations' tangent errors share kappa * t. Translations are parameters as they
+  // are (no Jacobian needed: their tangent and parameter coordinates agree).
+  Vector12d t = Vector12d::Zero();
+  t.segment<3>(layout::kCaml + layout::kTranslation) = extrinsics.T_veh_caml.translation();
+  t.segment<3>(layout::kCamr + layout::kTranslation) = extrinsics.T_caml_camr.translation();
+  return std::pow(config_.odometry_scale_sigma, 2) * t * t.transpose();
 }
 
 CalibrationEstimate StereoCalibrationEstimator::estimate() const {
@@ -261,18 +283,9 @@ CalibrationEstimate StereoCalibrationEstimator::estimate() const {
   e.parameters = e.extrinsics.toParameters();
   e.tangent_covariance = filter_.covariance();
   e.parameter_covariance = filter_.parameterCovariance();
-  if (config_.odometry_scale_sigma > 0.0) {
-    // Scaling every translation by 1 + kappa explains the pixels as well (filter_config.h):
-    // the translations' tangent errors share kappa * t. Translations are parameters as they
-    // are (no Jacobian needed: their tangent and parameter coordinates agree).
-    Vector12d t = Vector12d::Zero();
-    t.segment<3>(layout::kCaml + layout::kTranslation) = e.extrinsics.T_veh_caml.translation();
-    t.segment<3>(layout::kCamr + layout::kTranslation) = e.extrinsics.T_caml_camr.translation();
-    const Matrix12d scale = std::pow(config_.odometry_scale_sigma, 2) * t * t.transpose();
-    e.tangent_covariance += scale;
-    e.parameter_covariance += scale;
-    e.odometry_scale_covariance = scale;
-  }
+  e.odometry_scale_covariance = odometryScaleCovariance(e.extrinsics);
+  e.tangent_covariance += e.odometry_scale_covariance;
+  e.parameter_covariance += e.odometry_scale_covariance;
   e.tracked_points = filter_.pointCount();
   e.excitation = filter_.excitationGains();
   e.consistency = filter_.consistency();

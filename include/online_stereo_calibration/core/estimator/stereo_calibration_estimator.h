@@ -82,7 +82,10 @@ class StereoCalibrationEstimator {
   std::vector<PointId> reopenRightCameraRotation(double rotation_sigma);
   /// Starts over from a new guess with the config's initial uncertainty.
   void reset(const StereoExtrinsics& guess);
-  /// Starts over from a saved calibration with its covariance (tangent, see filter).
+  /// Starts over from a saved calibration with its covariance (tangent, see filter) as
+  /// estimate() reports it: estimate() right after gives it back, unless it is sharper than
+  /// the odometry's scale allows (FilterConfig::odometry_scale_sigma; e.g. sigmas only), in
+  /// which case it comes back widened by the scale.
   void reset(const StereoExtrinsics& guess, const Matrix12d& tangent_covariance);
 
   CalibrationEstimate estimate() const;
@@ -109,6 +112,9 @@ class StereoCalibrationEstimator {
   };
 
   bool toMeasurement(const StereoObservation& observation, PointMeasurement* measurement) const;
+  /// What the odometry's scale uncertainty adds to the covariance of the translations at
+  /// @p extrinsics (FilterConfig::odometry_scale_sigma; zero when 0).
+  Matrix12d odometryScaleCovariance(const StereoExtrinsics& extrinsics) const;
   /// Anchors at the filter's state now (after a start or re-opening of @p block).
   void anchorHere(JumpBlock block, double translation_sigma, double rotation_sigma);
   /// Largest move since the anchor of a tangent component of @p block (0 x_caml, 1 x_camr)
