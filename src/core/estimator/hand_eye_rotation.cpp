@@ -121,8 +121,8 @@ HandEyeRotationResult HandEyeRotation::solve() const {
     Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
     for (size_t i = 0; i < blocks.size(); ++i) {
       // Block residuals: |q_a - q_c| ~ angle / 2 for a rotation pair, ~ angle for a direction.
-      const double w = huber[i] * (i < rotations_.size() ? 2.0 / sigma_rotation
-                                                          : 1.0 / sigma_direction);
+      const double w =
+          huber[i] * (i < rotations_.size() ? 2.0 / sigma_rotation : 1.0 / sigma_direction);
       normal += w * w * blocks[i].transpose() * blocks[i];
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eigen(normal);
@@ -134,14 +134,13 @@ HandEyeRotationResult HandEyeRotation::solve() const {
       residuals[i] = residualOf(i, X);
       (i < rotations_.size() ? rotation_norms : direction_norms).push_back(residuals[i].norm());
     }
-    sigma_rotation =
-        std::max(config_.min_rotation_residual, median(rotation_norms) / kMedianNorm3);
+    sigma_rotation = std::max(config_.min_rotation_residual, median(rotation_norms) / kMedianNorm3);
     sigma_direction =
         std::max(config_.min_direction_residual, median(direction_norms) / kMedianNorm2);
     for (size_t i = 0; i < blocks.size(); ++i) {
-      const double bound = config_.huber_sigmas *
-                           (i < rotations_.size() ? kMedianNorm3 * sigma_rotation
-                                                  : kMedianNorm2 * sigma_direction);
+      const double bound =
+          config_.huber_sigmas *
+          (i < rotations_.size() ? kMedianNorm3 * sigma_rotation : kMedianNorm2 * sigma_direction);
       const double r = residuals[i].norm();
       huber[i] = r > bound ? std::sqrt(bound / r) : 1.0;  // Huber's IRLS weight on the row
     }
@@ -149,9 +148,8 @@ HandEyeRotationResult HandEyeRotation::solve() const {
   result.R_veh_cam = X;
   result.rotation_residual = result.rotation_pairs > 0 ? sigma_rotation : 0.0;
   result.direction_residual = result.direction_pairs > 0 ? sigma_direction : 0.0;
-  result.conditioning = eigenvalues(3) > 0.0
-                            ? std::sqrt(std::max(0.0, eigenvalues(1)) / eigenvalues(3))
-                            : 0.0;
+  result.conditioning =
+      eigenvalues(3) > 0.0 ? std::sqrt(std::max(0.0, eigenvalues(1)) / eigenvalues(3)) : 0.0;
 
   // Gauss-Newton information of the tangent error at X (central differences).
   Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
@@ -170,8 +168,9 @@ HandEyeRotationResult HandEyeRotation::solve() const {
   Eigen::Vector3d variances;
   for (int k = 0; k < 3; ++k) {
     const double lambda = info.eigenvalues()(k);
-    variances(k) = lambda > 1e-12 * std::max(largest, 1.0) ? 1.0 / lambda
-                                                           : std::numeric_limits<double>::infinity();
+    variances(k) = lambda > 1e-12 * std::max(largest, 1.0)
+                       ? 1.0 / lambda
+                       : std::numeric_limits<double>::infinity();
   }
   const Eigen::Matrix3d V = info.eigenvectors();
   result.covariance = std::isfinite(variances(0))
@@ -192,9 +191,9 @@ HandEyeRotationResult HandEyeRotation::solve() const {
         << config_.max_sigma / kDeg << "; " << result.rotation_pairs << " rotation and "
         << result.direction_pairs << " direction pairs)";
   } else {
-    why << "determined from " << result.rotation_pairs << " rotation and "
-        << result.direction_pairs << " direction pairs: worst axis [" << a.x() << ", " << a.y()
-        << ", " << a.z() << "] 1 sigma " << result.max_sigma / kDeg << " deg";
+    why << "determined from " << result.rotation_pairs << " rotation and " << result.direction_pairs
+        << " direction pairs: worst axis [" << a.x() << ", " << a.y() << ", " << a.z()
+        << "] 1 sigma " << result.max_sigma / kDeg << " deg";
   }
   result.reason = why.str();
   return result;

@@ -1,5 +1,12 @@
 #include "online_stereo_calibration/core/estimator/mounting_from_motion.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+#include "online_stereo_calibration/core/geometry/rotation.h"
+
 namespace osc {
 namespace {
 
@@ -9,8 +16,7 @@ constexpr double kMinTranslation = 0.05;
 
 }  // namespace
 
-MountingFromMotion::MountingFromMotion(const CameraModel& left,
-                                       const HandEyeRotationConfig& config)
+MountingFromMotion::MountingFromMotion(const CameraModel& left, const HandEyeRotationConfig& config)
     : left_(left), solver_(config) {
   motion_config_.focal = 0.5 * (left_.K()(0, 0) + left_.K()(1, 1));
 }
@@ -48,6 +54,37 @@ CameraMotion MountingFromMotion::addFrame(const MotionIncrement& motion, bool mo
 void MountingFromMotion::clear() {
   previous_.clear();
   solver_.clear();
+  done_ = false;
+  pairs_at_last_solve_ = -1;
+}
+
+bool MountingFromMotion::checkFilter(const Eigen::Matrix3d& R_filter,
+                                     const Eigen::Matrix3d& P_filter, double restart_distance,
+                                     double min_restart_sigma, MountingRestart* restart) {
+  const int pairs = solver_.rotationPairs() + solver_.directionPairs();
+  if (done_ || pairs == pairs_at_last_solve_) return false;  // nothing new to solve with
+  pairs_at_last_solve_ = pairs;
+  const HandEyeRotationResult hand_eye = solver_.solve();
+  if (!hand_eye.determined) return false;
+  done_ = true;
+  // The filter's error dtheta_f (R_true = R_filter Exp(dtheta_f)) and the hand-eye's error
+  // (R_true = R_he Exp(dtheta_h)): their difference log(R_filter^T R_he) has covariance
+  // P_filter + Ad P_he Ad^T, Ad = R_filter^T R_he (first order).
+  const Eigen::Matrix3d relative = R_filter.transpose() * hand_eye.R_veh_cam;
+  const Eigen::Vector3d difference = logSO3(relative);
+  const Eigen::Matrix3d covariance =
+      P_filter + relative * hand_eye.covariance * relative.transpose();
+  const double distance = std::sqrt(difference.dot(covariance.ldlt().solve(difference)));
+  if (!(distance > restart_distance)) return false;
+  restart->R_veh_caml = hand_eye.R_veh_cam;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(hand_eye.covariance);
+  const Eigen::Vector3d widened =
+      eigen.eigenvalues().cwiseMax(min_restart_sigma * min_restart_sigma);
+  restart->covariance =
+      eigen.eigenvectors() * widened.asDiagonal() * eigen.eigenvectors().transpose();
+  restart->distance = distance;
+  restart->hand_eye = hand_eye;
+  return true;
 }
 
 }  // namespace osc

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <sstream>
 
+#include "online_stereo_calibration/core/filter/state_layout.h"
+#include "online_stereo_calibration/core/geometry/rotation.h"
+
 namespace osc {
 namespace {
 
@@ -17,6 +20,12 @@ StereoIntrinsics stereoIntrinsics(const CameraModel& left, const CameraModel& ri
   return k;
 }
 
+HandEyeRotationConfig handEyeConfig(const FilterConfig& config) {
+  HandEyeRotationConfig h;
+  h.max_sigma = config.hand_eye_max_sigma;
+  return h;
+}
+
 }  // namespace
 
 StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& config,
@@ -26,7 +35,9 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
     : config_(config),
       left_(left),
       right_(right),
-      filter_(config, stereoIntrinsics(left_, right_)) {
+      filter_(config, stereoIntrinsics(left_, right_)),
+      guess_(initial_guess),
+      mounting_(left_, handEyeConfig(config)) {
   filter_.reset(initial_guess);
   anchorHere(JumpBlock::kNone, 0.0, 0.0);
 }
@@ -123,6 +134,55 @@ bool StereoCalibrationEstimator::relinearizeIfMoved(FrameReport* report) {
   return true;
 }
 
+bool StereoCalibrationEstimator::restartFromMotion(
+    const MotionIncrement& motion, const std::vector<StereoObservation>& observations,
+    FrameReport* report) {
+  using namespace layout;
+  mounting_.addFrame(motion, has_previous_frame_, observations);
+  MountingRestart restart;
+  const StereoExtrinsics now = filter_.extrinsics();
+  auto covariance = filter_.covariance();
+  if (!mounting_.checkFilter(now.T_veh_caml.linear(),
+                             covariance.template block<3, 3>(kCaml + kRotation, kCaml + kRotation),
+                             config_.hand_eye_restart_distance, config_.hand_eye_min_restart_sigma,
+                             &restart)) {
+    return false;
+  }
+  // A fresh start from the guess, with the hand-eye rotation for x_caml's: everything learned
+  // so far was learned with x_caml's rotation far off (x_camr too: in the first frames the
+  // filter explains the wrong rotation's mispredictions partly with x_camr, 36 sigma off in
+  // yr after one frame with a backward camera guessed forward). A camera whose rotation was
+  // guessed this far off is likely elsewhere too (at the tailgate, under a mirror): its
+  // translation starts from the guess with at least hand_eye_restart_translation_sigma.
+  StereoExtrinsics start = guess_;
+  start.T_veh_caml.linear() = restart.R_veh_caml;
+  for (const PointEstimate& p : filter_.points()) report->dropped.push_back(p.id);
+  filter_.reset(start);
+  covariance = filter_.covariance();
+  covariance.template middleRows<kPoseDim>(kCaml).setZero();
+  covariance.template middleCols<kPoseDim>(kCaml).setZero();
+  const double translation_sigma =
+      std::max(config_.initial_caml_translation_sigma, config_.hand_eye_restart_translation_sigma);
+  covariance.template block<3, 3>(kCaml + kTranslation, kCaml + kTranslation) =
+      Eigen::Matrix3d::Identity() * translation_sigma * translation_sigma;
+  covariance.template block<3, 3>(kCaml + kRotation, kCaml + kRotation) = restart.covariance;
+  filter_.reset(start, covariance);
+  anchorHere(JumpBlock::kNone, 0.0, 0.0);  // a start: both blocks re-linearised as after one
+  report->mounting_rotation_from_motion = true;
+  const Eigen::Vector3d before = rpyFromRotation(now.T_veh_caml.linear()) * 180.0 / M_PI;
+  const Eigen::Vector3d after = rpyFromRotation(restart.R_veh_caml) * 180.0 / M_PI;
+  std::ostringstream message;
+  message.precision(4);
+  message << "mounting rotation from motion: x_caml restarted from roll/pitch/yaw " << after(0)
+          << "/" << after(1) << "/" << after(2) << " deg (was " << before(0) << "/" << before(1)
+          << "/" << before(2) << " deg, " << restart.distance
+          << " sigmas apart; hand-eye " << restart.hand_eye.reason
+          << "); everything else from the guess again, translation 1 sigma " << translation_sigma
+          << " m; tracks reset";
+  report->warnings.push_back(message.str());
+  return true;
+}
+
 bool StereoCalibrationEstimator::toMeasurement(const StereoObservation& o,
                                                PointMeasurement* m) const {
   if (!o.left_pixel.allFinite() || !o.right_pixel.allFinite() || !std::isfinite(o.sigma_left) ||
@@ -145,6 +205,10 @@ bool StereoCalibrationEstimator::toMeasurement(const StereoObservation& o,
 FrameReport StereoCalibrationEstimator::processFrame(
     const MotionIncrement& motion, const std::vector<StereoObservation>& observations) {
   FrameReport report;
+  if (config_.hand_eye_start != 0 && !mounting_.done() &&
+      restartFromMotion(motion, observations, &report)) {
+    has_previous_frame_ = false;  // tracking starts afresh with this pair, as after a start
+  }
   std::vector<PointMeasurement> tracked, candidates;
   for (const StereoObservation& o : observations) {
     PointMeasurement m;
@@ -232,6 +296,7 @@ std::vector<PointId> StereoCalibrationEstimator::resetTracking() {
   for (const PointEstimate& p : filter_.points()) dropped.push_back(p.id);
   for (PointId id : dropped) filter_.removePoint(id);
   has_previous_frame_ = false;
+  mounting_.forgetFrame();
   return dropped;
 }
 
@@ -243,6 +308,8 @@ std::vector<PointId> StereoCalibrationEstimator::reopenRightCameraRotation(doubl
 }
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
+  guess_ = guess;
+  mounting_.clear();
   filter_.reset(guess);
   has_previous_frame_ = false;
   anchorHere(JumpBlock::kNone, 0.0, 0.0);
@@ -250,6 +317,8 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
                                        const Matrix12d& tangent_covariance) {
+  guess_ = guess;
+  mounting_.clear();
   filter_.reset(guess, tangent_covariance);
   has_previous_frame_ = false;
   anchorHere(JumpBlock::kNone, 0.0, 0.0);

@@ -119,6 +119,24 @@ struct FilterConfig {
 
   /// Every problem found, each naming the parameter, its value and the allowed range.
   std::vector<std::string> validate() const;
+
+  // --- hand-eye rotation at start (issue 14) ---
+  /// 1: until x_caml's rotation is determined from the motion alone (hand_eye_rotation.h),
+  /// the estimator collects the left camera's and the vehicle's motion pairs, and restarts
+  /// x_caml from that rotation if the filter's estimate disagrees with it (a camera mounted
+  /// backwards or sideways with a forward guess); 0: off (the paper).
+  int hand_eye_start = 1;
+  /// rad: the hand-eye rotation counts as determined when its worst axis' 1 sigma is below.
+  double hand_eye_max_sigma = 1.5 * 0.0174532925199432958;
+  /// rad: least rotation 1 sigma x_caml is restarted with (the hand-eye's own sigma ignores
+  /// the camera's lever arm and correlated odometry errors).
+  double hand_eye_min_restart_sigma = 3.0 * 0.0174532925199432958;
+  /// Restart when the filter's rotation is farther from the hand-eye's than this Mahalanobis
+  /// distance (both covariances, 3 dof).
+  double hand_eye_restart_distance = 3.0;
+  /// m: least translation 1 sigma x_caml is restarted with (a camera whose rotation was
+  /// guessed that far off is likely elsewhere too: at the tailgate, under a mirror).
+  double hand_eye_restart_translation_sigma = 1.5;
 };
 
 /// One row of the parameter table.

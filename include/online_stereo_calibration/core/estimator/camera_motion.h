@@ -16,8 +16,8 @@ namespace osc {
 
 /// Thresholds of one camera-motion fit.
 struct CameraMotionConfig {
-  int min_points = 15;           ///< fewest common points for a fit
-  int min_inliers = 12;          ///< fewest RANSAC inliers for a usable fit
+  int min_points = 15;            ///< fewest common points for a fit
+  int min_inliers = 12;           ///< fewest RANSAC inliers for a usable fit
   double ransac_threshold = 1.5;  ///< px (converted with the focal length), Sampson distance
   /// Least median parallax (px) of the inliers after removing the fitted rotation: below it
   /// the translation direction (and the essential matrix) is not determined.
@@ -33,9 +33,9 @@ struct CameraMotion {
   Eigen::Matrix3d R_prev_curr = Eigen::Matrix3d::Identity();
   /// Unit direction of the camera's translation (c1's origin in c0), in c0 body coordinates.
   Eigen::Vector3d translation_direction = Eigen::Vector3d::UnitX();
-  int points = 0;          ///< common points given
-  int inliers = 0;         ///< RANSAC inliers in front of both cameras
-  double parallax = 0.0;   ///< median parallax (px) of the inliers after derotation
+  int points = 0;         ///< common points given
+  int inliers = 0;        ///< RANSAC inliers in front of both cameras
+  double parallax = 0.0;  ///< median parallax (px) of the inliers after derotation
 };
 
 /// Fits the motion from normalised undistorted coordinates (x/z, y/z in the optical frame)

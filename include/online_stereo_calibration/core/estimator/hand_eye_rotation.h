@@ -28,8 +28,8 @@ namespace osc {
 
 /// Settings of the hand-eye rotation solver.
 struct HandEyeRotationConfig {
-  int min_pairs = 20;      ///< fewest pairs (both kinds) before a solution is offered
-  size_t window = 400;     ///< most recent pairs kept per kind
+  int min_pairs = 20;   ///< fewest pairs (both kinds) before a solution is offered
+  size_t window = 400;  ///< most recent pairs kept per kind
   double max_sigma = 1.5 * 0.0174532925199432958;  ///< rad: accepted when every axis is below
   double huber_sigmas = 3.0;  ///< residuals beyond this many sigmas of their kind are damped
   /// rad: lower bounds of the per-axis residual sigma of each kind (the scatter estimated from

@@ -18,6 +18,16 @@
 
 namespace osc {
 
+/// A restart of x_caml's rotation that the motion asks for.
+struct MountingRestart {
+  Eigen::Matrix3d R_veh_caml = Eigen::Matrix3d::Identity();  ///< the hand-eye rotation
+  /// Covariance (rad^2) of its tangent error (filter's convention, pose.h boxPlus), every
+  /// axis at least min_restart_sigma.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  double distance = 0.0;  ///< Mahalanobis distance to the filter's rotation (3 dof)
+  HandEyeRotationResult hand_eye;
+};
+
 /// Collects the motion pairs of a drive for the hand-eye rotation of the left camera.
 class MountingFromMotion {
  public:
@@ -31,8 +41,18 @@ class MountingFromMotion {
                         const std::vector<StereoObservation>& observations);
   /// Forgets the previous frame (the next one starts a new pair); the pairs are kept.
   void forgetFrame() { previous_.clear(); }
-  /// Forgets everything.
+  /// Forgets everything and starts collecting again.
   void clear();
+
+  /// Once the hand-eye rotation is determined (done() from then on): true if the filter's
+  /// rotation R_filter (with its tangent covariance P_filter, rad^2) is farther from it than
+  /// @p restart_distance (Mahalanobis, both covariances), with the restart in @p restart.
+  /// Its covariance is the hand-eye's with every axis widened to at least
+  /// @p min_restart_sigma (rad). False while undetermined or when they agree.
+  bool checkFilter(const Eigen::Matrix3d& R_filter, const Eigen::Matrix3d& P_filter,
+                   double restart_distance, double min_restart_sigma, MountingRestart* restart);
+  /// The rotation was determined (and compared with the filter): collecting has ended.
+  bool done() const { return done_; }
 
   /// The hand-eye solution of the pairs so far.
   HandEyeRotationResult solve() const { return solver_.solve(); }
@@ -42,6 +62,8 @@ class MountingFromMotion {
   CameraModel left_;
   CameraMotionConfig motion_config_;
   HandEyeRotation solver_;
+  bool done_ = false;
+  int pairs_at_last_solve_ = -1;
   /// Normalised undistorted left coordinates of the previous frame's observations, by id.
   std::unordered_map<PointId, Eigen::Vector2d> previous_;
 };
