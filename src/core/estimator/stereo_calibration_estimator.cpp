@@ -175,8 +175,8 @@ bool StereoCalibrationEstimator::restartFromMotion(
   message.precision(4);
   message << "mounting rotation from motion: x_caml restarted from roll/pitch/yaw " << after(0)
           << "/" << after(1) << "/" << after(2) << " deg (was " << before(0) << "/" << before(1)
-          << "/" << before(2) << " deg, " << restart.distance
-          << " sigmas apart; hand-eye " << restart.hand_eye.reason
+          << "/" << before(2) << " deg, " << restart.distance << " sigmas apart; hand-eye "
+          << restart.hand_eye.reason
           << "); everything else from the guess again, translation 1 sigma " << translation_sigma
           << " m; tracks reset";
   report->warnings.push_back(message.str());
