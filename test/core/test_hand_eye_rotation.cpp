@@ -104,6 +104,18 @@ TEST(HandEyeRotation, NoRotationAndTooFewPairsAreNotDetermined) {
   const HandEyeRotationResult r = solver.solve();
   EXPECT_FALSE(r.determined) << r.reason;
   EXPECT_NE(r.reason.find("not determined yet"), std::string::npos);
+  // Driving straight: the driving direction alone leaves the rotation about it (roll) open,
+  // however many pairs.
+  const Eigen::Matrix3d X = rotationFromRpy(Eigen::Vector3d(0.0, 0.0, M_PI));
+  feed(&solver, X, Eigen::Vector3d::Zero(), 0.0, false, 400, &rng);
+  for (int i = 0; i < 400; ++i) {  // along x exactly, the camera's direction with 1 deg noise
+    solver.addDirectionPair(Eigen::Vector3d(0.35, 0.0, 0.0),
+                            X.transpose() * Eigen::Vector3d::UnitX() + gaussian3(&rng, 1.0 * kDeg));
+  }
+  const HandEyeRotationResult straight = solver.solve();
+  EXPECT_FALSE(straight.determined) << straight.reason;
+  EXPECT_EQ(straight.rotation_pairs, 0);  // below min_rotation: no excitation
+  EXPECT_GT(std::abs(straight.weakest_axis_vehicle.x()), 0.99) << straight.reason;
 }
 
 TEST(HandEyeRotation, IsRobustToAFewOutlierPairs) {

@@ -61,7 +61,10 @@ HandEyeRotation::HandEyeRotation(const HandEyeRotationConfig& config) : config_(
 
 void HandEyeRotation::addRotationPair(const Eigen::Matrix3d& R_vehicle,
                                       const Eigen::Matrix3d& R_camera) {
-  if (!R_vehicle.allFinite() || !R_camera.allFinite()) return;
+  if (!R_vehicle.allFinite() || !R_camera.allFinite() ||
+      !(logSO3(R_vehicle).norm() >= config_.min_rotation)) {
+    return;
+  }
   rotations_.push_back({R_vehicle, R_camera});
   while (rotations_.size() > config_.window) rotations_.pop_front();
 }

@@ -23,6 +23,8 @@ StereoIntrinsics stereoIntrinsics(const CameraModel& left, const CameraModel& ri
 HandEyeRotationConfig handEyeConfig(const FilterConfig& config) {
   HandEyeRotationConfig h;
   h.max_sigma = config.hand_eye_max_sigma;
+  // Five times the odometry's rotation noise per axis per step: below, no excitation.
+  h.min_rotation = 5.0 * config.motion_rotation_noise;
   return h;
 }
 
