@@ -1,6 +1,11 @@
 // The hand-eye start (issue 14): the camera's mounting rotation from the vehicle's and the
 // camera's motion alone (hand_eye_rotation.h), the camera's motion from two images
 // (camera_motion.h), and end to end through the estimator (mounting_from_motion.h).
+// Environment, for investigating only (the asserted tests ignore it unless noted):
+// OSC_HAND_EYE_TRACE=1 prints every frame's errors/sigmas and the hand-eye's state;
+// OSC_HAND_EYE_ONLY=<yaw rad> runs one mounting of the end-to-end test; for DISABLED_Report,
+// OSC_HAND_EYE_FIRST=<frame> (default 30) is the first scored frame and
+// OSC_HAND_EYE_CASE=<text> keeps the cases whose name contains it (hand-eye on only).
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -151,7 +156,7 @@ TEST(CameraMotion, RecoversRotationAndTranslationDirectionInTheBodyFrame) {
   ASSERT_TRUE(m.valid) << m.why;
   EXPECT_LT(rotationDistance(m.R_prev_curr, T_c0_c1.linear()), 0.1 * kDeg);
   EXPECT_LT(std::acos(m.translation_direction.dot(T_c0_c1.translation().normalized())), 1.0 * kDeg);
-  EXPECT_GE(m.inliers, 80);  // Sampson distance within 1.5 px of 0.5 px noise per coordinate
+  EXPECT_GE(m.inliers, 95);  // all but the outlier, Sampson distance within 1.5 px
   // No translation: no parallax, no fit.
   std::vector<Eigen::Vector2d> same = p0;
   EXPECT_FALSE(estimateCameraMotion(p0, same, CameraMotionConfig()).valid);

@@ -1,7 +1,8 @@
 /// @file camera_motion.h
 /// @brief One camera's motion between two images from the same points seen in both: the
-/// essential matrix by RANSAC (five-point, cv::findEssentialMat) and its decomposition
-/// (cv::recoverPose), in the camera's *body* frame (pose.h: x forward, y left, z up).
+/// essential matrix by RANSAC (five-point, cv::findEssentialMat), its decomposition
+/// (cv::recoverPose) and a Gauss-Newton refinement on the Sampson distances of every point
+/// within the threshold, in the camera's *body* frame (pose.h: x forward, y left, z up).
 ///
 /// Used by the hand-eye start (mounting_from_motion.h) for the left camera's rotation and
 /// translation direction between consecutive frames.
