@@ -38,16 +38,24 @@ CameraMotion MountingFromMotion::addFrame(const MotionIncrement& motion, bool mo
     now.push_back(normalized);
   }
   CameraMotion fit;
-  if (motion_usable && motion.T_prev_curr.matrix().allFinite()) {
-    fit = estimateCameraMotion(before, now, motion_config_);
-    if (fit.valid) {
-      solver_.addRotationPair(motion.T_prev_curr.linear(), fit.R_prev_curr);
-      if (motion.T_prev_curr.translation().norm() > kMinTranslation) {
-        solver_.addDirectionPair(motion.T_prev_curr.translation(), fit.translation_direction);
-      }
+  last_motion_usable_ = motion_usable && motion.T_prev_curr.matrix().allFinite();
+  if (last_motion_usable_) fit = addMatches(motion, before, now);
+  last_frame_paired_ = fit.valid;
+  previous_.swap(current);
+  return fit;
+}
+
+CameraMotion MountingFromMotion::addMatches(const MotionIncrement& motion,
+                                            const std::vector<Eigen::Vector2d>& previous,
+                                            const std::vector<Eigen::Vector2d>& current) {
+  if (done_ || !motion.T_prev_curr.matrix().allFinite()) return CameraMotion();
+  const CameraMotion fit = estimateCameraMotion(previous, current, motion_config_);
+  if (fit.valid) {
+    solver_.addRotationPair(motion.T_prev_curr.linear(), fit.R_prev_curr);
+    if (motion.T_prev_curr.translation().norm() > kMinTranslation) {
+      solver_.addDirectionPair(motion.T_prev_curr.translation(), fit.translation_direction);
     }
   }
-  previous_.swap(current);
   return fit;
 }
 
@@ -55,6 +63,7 @@ void MountingFromMotion::clear() {
   previous_.clear();
   solver_.clear();
   done_ = false;
+  last_motion_usable_ = last_frame_paired_ = false;
   pairs_at_last_solve_ = -1;
 }
 

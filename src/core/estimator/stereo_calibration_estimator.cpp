@@ -185,6 +185,16 @@ bool StereoCalibrationEstimator::restartFromMotion(
   return true;
 }
 
+bool StereoCalibrationEstimator::wantsLeftCameraMatches() const {
+  return handEyeActive() && mounting_.lastMotionUsable() && !mounting_.lastFramePaired();
+}
+
+void StereoCalibrationEstimator::addLeftCameraMatches(const MotionIncrement& motion,
+                                                      const std::vector<Eigen::Vector2d>& previous,
+                                                      const std::vector<Eigen::Vector2d>& current) {
+  if (wantsLeftCameraMatches()) mounting_.addMatches(motion, previous, current);
+}
+
 bool StereoCalibrationEstimator::toMeasurement(const StereoObservation& o,
                                                PointMeasurement* m) const {
   if (!o.left_pixel.allFinite() || !o.right_pixel.allFinite() || !std::isfinite(o.sigma_left) ||
@@ -207,8 +217,7 @@ bool StereoCalibrationEstimator::toMeasurement(const StereoObservation& o,
 FrameReport StereoCalibrationEstimator::processFrame(
     const MotionIncrement& motion, const std::vector<StereoObservation>& observations) {
   FrameReport report;
-  if (config_.hand_eye_start != 0 && !mounting_.done() &&
-      restartFromMotion(motion, observations, &report)) {
+  if (handEyeActive() && restartFromMotion(motion, observations, &report)) {
     has_previous_frame_ = false;  // tracking starts afresh with this pair, as after a start
   }
   std::vector<PointMeasurement> tracked, candidates;

@@ -39,6 +39,15 @@ class MountingFromMotion {
   /// motion). Returns the fit of the camera motion (valid false if none was made).
   CameraMotion addFrame(const MotionIncrement& motion, bool motion_usable,
                         const std::vector<StereoObservation>& observations);
+  /// The same from correspondences found otherwise (left_motion_matches.h, when the ids do
+  /// not persist): normalised coordinates of the same points in the previous and the current
+  /// left image, @p motion the vehicle's over the same interval.
+  CameraMotion addMatches(const MotionIncrement& motion,
+                          const std::vector<Eigen::Vector2d>& previous,
+                          const std::vector<Eigen::Vector2d>& current);
+  /// The last addFrame had a usable motion, and its ids gave a pair.
+  bool lastMotionUsable() const { return last_motion_usable_; }
+  bool lastFramePaired() const { return last_frame_paired_; }
   /// Forgets the previous frame (the next one starts a new pair); the pairs are kept.
   void forgetFrame() { previous_.clear(); }
   /// Forgets everything and starts collecting again.
@@ -63,6 +72,7 @@ class MountingFromMotion {
   CameraMotionConfig motion_config_;
   HandEyeRotation solver_;
   bool done_ = false;
+  bool last_motion_usable_ = false, last_frame_paired_ = false;
   int pairs_at_last_solve_ = -1;
   /// Normalised undistorted left coordinates of the previous frame's observations, by id.
   std::unordered_map<PointId, Eigen::Vector2d> previous_;

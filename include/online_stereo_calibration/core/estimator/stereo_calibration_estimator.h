@@ -86,6 +86,18 @@ class StereoCalibrationEstimator {
   const CalibrationFilter& filter() const { return filter_; }
   const CameraModel& leftCamera() const { return left_; }
   const CameraModel& rightCamera() const { return right_; }
+  /// The hand-eye start still collects and the last processFrame's ids gave it no pair (at
+  /// image level with x_caml far off no track survives from one pair to the next): a caller
+  /// with the images may give it the left image's own matches (addLeftCameraMatches).
+  bool wantsLeftCameraMatches() const;
+  /// Correspondences of the previous and the last processed pair's left images (normalised
+  /// coordinates, left_motion_matches.h) for the hand-eye start, with the motion given to that
+  /// processFrame. Ignored unless wantsLeftCameraMatches().
+  void addLeftCameraMatches(const MotionIncrement& motion,
+                            const std::vector<Eigen::Vector2d>& previous,
+                            const std::vector<Eigen::Vector2d>& current);
+  /// The hand-eye start is still collecting (on, rotation not yet determined).
+  bool handEyeActive() const { return config_.hand_eye_start != 0 && !mounting_.done(); }
   /// The hand-eye start's pairs and solver (FilterConfig::hand_eye_start).
   const MountingFromMotion& mountingFromMotion() const { return mounting_; }
 
