@@ -14,7 +14,8 @@
 
 namespace osc {
 
-/// Matches the keypoints of the previous left image to the current one's: mutual best
+/// Matches the 500 strongest keypoints (detector response) of the previous left image to the
+/// current one's 500: mutual best
 /// descriptor matches, each better than @p ratio times the second best in both directions.
 /// Outputs the matched keypoints' normalised undistorted coordinates (x/z, y/z, optical frame),
 /// in the same order. Descriptors of different types give no match.
