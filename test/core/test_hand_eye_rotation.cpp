@@ -9,12 +9,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <random>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "online_stereo_calibration/core/estimator/camera_motion.h"
 #include "online_stereo_calibration/core/estimator/hand_eye_rotation.h"
@@ -23,6 +25,7 @@
 #include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
 #include "online_stereo_calibration/core/sim/image_scenario_runner.h"
 #include "online_stereo_calibration/core/sim/scenario_runner.h"
+#include "online_stereo_calibration/tools/kitti_sequence.h"
 
 namespace osc {
 namespace {
@@ -313,6 +316,68 @@ TEST(HandEyeStart, ImageLevelBackwardAndSidewaysCamerasGuessedForward) {
     EXPECT_LT(determined_at, 20);
     EXPECT_GE(within, 0.95 * frames) << "yaw " << mounting(5);
     EXPECT_EQ(beyond, 0) << "yaw " << mounting(5) << " worst " << worst;
+  }
+}
+
+// The image-level figures of docs/RESULTS.md ("Hand-eye start"): the three mountings rendered
+// (60 frames), and KITTI's two real stretches guessed at KITTI's calibration and with yaw_l +
+// 180 deg. Run with --gtest_also_run_disabled_tests.
+TEST(HandEyeStart, DISABLED_ImageLevelReport) {
+  Vector6d backward, left, right;
+  backward << -0.8, 0.0, 1.4, 0.0, 0.0, M_PI;
+  left << 1.0, 0.9, 1.1, 0.0, 0.0, M_PI / 2.0;
+  right << 1.0, -0.9, 1.1, 0.0, 0.0, -M_PI / 2.0;
+  for (const Vector6d& mounting : {backward, left, right}) {
+    int determined_at = -1;
+    double error_then = 0.0, error_at_40 = 0.0, worst_from_30 = 0.0;
+    runImageScenario(mountedScenario(mounting, 60), FilterConfig(), FrontEndConfig(), {},
+                     [&](const ImageFrameResult& r, const CalibrationPipeline& pipeline) {
+                       const double error = r.filter.tangent_error.segment<3>(3).norm();
+                       if (determined_at < 0 && pipeline.estimator().mountingFromMotion().done()) {
+                         determined_at = r.filter.frame;
+                         error_then = error;
+                       }
+                       if (r.filter.frame == 40) error_at_40 = error;
+                       if (r.filter.frame >= 30) {
+                         worst_from_30 =
+                             std::max(worst_from_30,
+                                      r.filter.tangent_error.cwiseQuotient(r.filter.tangent_sigmas)
+                                          .cwiseAbs()
+                                          .maxCoeff());
+                       }
+                     });
+    std::cout << "rendered, yaw " << mounting(5) / kDeg << " deg: determined at frame "
+              << determined_at << ", x_caml's rotation then " << error_then / kDeg
+              << " deg off, at frame 40 " << error_at_40 / kDeg << " deg; worst abs(e)/sigma from "
+              << "frame 30 " << worst_from_30 << "\n";
+  }
+  const std::string kitti = std::string(OSC_SOURCE_DIR) + "/../shared/data/kitti_odometry_51";
+  if (!std::ifstream(kitti + "/seq1/calib.txt").good()) GTEST_SKIP() << "no KITTI data";
+  for (const char* seq : {"seq1", "seq2"}) {
+    const KittiSequence sequence = readKittiSequence(kitti + "/" + seq);
+    const Vector12d truth = sequence.truth();
+    for (double yaw : {0.0, M_PI}) {
+      Vector12d guess = truth;
+      guess(5) += yaw;
+      CalibrationPipeline pipeline(FilterConfig(), FrontEndConfig(), sequence.left, sequence.right,
+                                   StereoExtrinsics::fromParameters(guess));
+      int restart = -1;
+      for (int k = 0; k < sequence.frames(); ++k) {
+        const PipelineResult r = pipeline.process(
+            cv::imread(sequence.left_images[static_cast<size_t>(k)], cv::IMREAD_GRAYSCALE),
+            cv::imread(sequence.right_images[static_cast<size_t>(k)], cv::IMREAD_GRAYSCALE),
+            k > 0 ? sequence.motion(k) : MotionIncrement());
+        if (r.estimator.mounting_rotation_from_motion) restart = k;
+      }
+      const HandEyeRotationResult h = pipeline.estimator().mountingFromMotion().solve();
+      const Eigen::Matrix3d X = StereoExtrinsics::fromParameters(truth).T_veh_caml.linear();
+      std::cout << "KITTI " << seq << ", guess yaw_l + " << yaw / kDeg << " deg: restart at "
+                << restart << "; " << h.reason << "; hand-eye "
+                << rotationDistance(h.R_veh_cam, X) / kDeg << " deg from KITTI's; yaw_l at the "
+                << "end "
+                << wrapAngle(pipeline.estimator().estimate().parameters(5) - truth(5)) / kDeg
+                << " deg off\n";
+    }
   }
 }
 
