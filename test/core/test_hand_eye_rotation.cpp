@@ -284,6 +284,44 @@ TEST(HandEyeStart, ForwardDriveWithAGoodGuessIsNotRestarted) {
   EXPECT_EQ(on.restarts, 0);
 }
 
+// The restart starts afresh from the guess: x_caml with the hand-eye rotation and the restart
+// sigmas, x_camr with the covariance the guess came with (here a saved calibration's).
+TEST(HandEyeStart, RestartKeepsTheGuessCovarianceOfTheRightCamera) {
+  Vector6d backward;
+  backward << -0.8, 0.0, 1.4, 0.0, 0.0, M_PI;
+  const MeasurementScenario s = mountedScenario(backward, 40);
+  MeasurementSimulator simulator(s);
+  StereoCalibrationEstimator estimator(FilterConfig(), s.left, s.right, simulator.initialGuess());
+  Matrix12d saved = Matrix12d::Zero();
+  saved.diagonal().head<3>().setConstant(0.25);                     // 0.5 m
+  saved.diagonal().segment<3>(3).setConstant(std::pow(0.1, 2));     // 5.7 deg
+  saved.diagonal().segment<3>(6).setConstant(1e-4);                 // 1 cm
+  saved.diagonal().tail<3>().setConstant(std::pow(0.2 * kDeg, 2));  // 0.2 deg
+  estimator.reset(simulator.initialGuess(), saved);
+  SimulatedFrame frame;
+  bool restarted = false;
+  while (!restarted && simulator.nextFrame(&frame)) {
+    const FrameReport report = estimator.processFrame(frame.measured_motion, frame.observations);
+    simulator.dropTracks(report.dropped);
+    restarted = report.mounting_rotation_from_motion;
+    if (!restarted) continue;
+    ASSERT_FALSE(report.warnings.empty());
+    EXPECT_NE(report.warnings.back().find("mounting rotation from motion"), std::string::npos);
+    const CalibrationEstimate e = estimator.estimate();
+    // Right after the restart (no update yet): the restart's sigmas and the saved x_camr.
+    EXPECT_NEAR(std::sqrt(e.tangent_covariance(0, 0)), 1.5, 1e-9);
+    for (int k = 3; k < 6; ++k) EXPECT_GE(std::sqrt(e.tangent_covariance(k, k)), 3.0 * kDeg - 1e-9);
+    EXPECT_NEAR(e.tangent_covariance(6, 6), 1e-4, 1e-12);
+    EXPECT_NEAR(e.tangent_covariance(11, 11), std::pow(0.2 * kDeg, 2), 1e-12);
+    const double cross = e.tangent_covariance.block<6, 6>(0, 6).cwiseAbs().maxCoeff();
+    EXPECT_EQ(cross, 0.0);
+    EXPECT_TRUE(e.extrinsics.T_caml_camr.isApprox(simulator.initialGuess().T_caml_camr));
+    EXPECT_LT(rotationDistance(e.extrinsics.T_veh_caml.linear(), frame.truth.T_veh_caml.linear()),
+              5.0 * kDeg);
+  }
+  EXPECT_TRUE(restarted);
+}
+
 // Image level (rendered images, the front end, CalibrationPipeline): with x_caml 90-180 deg
 // off the front end loses every track (it searches the filter's predicted windows), so the
 // hand-eye gets the left images' own keypoint matches (left_motion_matches.h). The rotation is

@@ -41,6 +41,7 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
       guess_(initial_guess),
       mounting_(left_, handEyeConfig(config)) {
   filter_.reset(initial_guess);
+  guess_covariance_ = filter_.covariance();
   anchorHere(JumpBlock::kNone, 0.0, 0.0);
 }
 
@@ -156,11 +157,11 @@ bool StereoCalibrationEstimator::restartFromMotion(
   // yr after one frame with a backward camera guessed forward). A camera whose rotation was
   // guessed this far off is likely elsewhere too (at the tailgate, under a mirror): its
   // translation starts from the guess with at least hand_eye_restart_translation_sigma.
+  // x_camr: the guess's covariance (the config's start sigmas, or a saved calibration's).
   StereoExtrinsics start = guess_;
   start.T_veh_caml.linear() = restart.R_veh_caml;
   for (const PointEstimate& p : filter_.points()) report->dropped.push_back(p.id);
-  filter_.reset(start);
-  covariance = filter_.covariance();
+  covariance = guess_covariance_;
   covariance.template middleRows<kPoseDim>(kCaml).setZero();
   covariance.template middleCols<kPoseDim>(kCaml).setZero();
   const double translation_sigma =
@@ -322,6 +323,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
   guess_ = guess;
   mounting_.clear();
   filter_.reset(guess);
+  guess_covariance_ = filter_.covariance();
   has_previous_frame_ = false;
   anchorHere(JumpBlock::kNone, 0.0, 0.0);
 }
@@ -331,6 +333,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
   guess_ = guess;
   mounting_.clear();
   filter_.reset(guess, tangent_covariance);
+  guess_covariance_ = filter_.covariance();
   has_previous_frame_ = false;
   anchorHere(JumpBlock::kNone, 0.0, 0.0);
 }

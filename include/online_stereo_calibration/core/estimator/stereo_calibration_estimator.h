@@ -147,7 +147,9 @@ class StereoCalibrationEstimator {
   CalibrationFilter filter_;
   bool has_previous_frame_ = false;
   LinearizationAnchor anchor_;
-  StereoExtrinsics guess_;  ///< the last start's guess (its translation for restartFromMotion)
+  /// The last start's guess and its tangent covariance (restartFromMotion starts from them).
+  StereoExtrinsics guess_;
+  Eigen::MatrixXd guess_covariance_;
   MountingFromMotion mounting_;
 };
 
