@@ -436,6 +436,10 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
         warning.rfind("no point could be initialised", 0) == 0) {
       diagnostics_->recordProblem("no point initialised", warning);
     }
+    if (result.estimator.mounting_rotation_from_motion &&
+        warning.rfind("mounting rotation from motion", 0) == 0) {
+      diagnostics_->recordProblem("mounting rotation from motion", warning);
+    }
   }
   for (const std::string& warning : result.estimator.warnings) {
     NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: %s", warning.c_str());

@@ -150,6 +150,23 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "time for that factor to grow tenfold while the block's statistic is above its bound"),
       real("drift_inflation_relax_s", &C::drift_inflation_relax, 1.0, 0.0, 1e6,
            "time constant of the factor's logarithm relaxing to 0 once consistent (0 = at once)"),
+      // --- hand-eye rotation at start (issue 14) ---
+      integer("hand_eye_start", &C::hand_eye_start, 0, 1,
+              "1: determine x_caml's rotation from the camera's and the vehicle's motion at the "
+              "start and, if the estimate disagrees, start afresh from the guess with it (a "
+              "camera mounted backwards or sideways); 0: off"),
+      real("hand_eye_max_sigma_deg", &C::hand_eye_max_sigma, kDeg, 1e-3, 90.0,
+           "the hand-eye rotation is determined when its worst axis' 1 sigma is below this"),
+      real("hand_eye_min_restart_sigma_deg", &C::hand_eye_min_restart_sigma, kDeg, 0.0, 90.0,
+           "least 1 sigma per axis of the hand-eye rotation, for the comparison with the "
+           "filter and for the restart"),
+      real("hand_eye_restart_distance", &C::hand_eye_restart_distance, 1.0, 0.0, 1e6,
+           "restart x_caml when its rotation is farther from the hand-eye one than this "
+           "Mahalanobis distance (3 dof)"),
+      real("hand_eye_restart_translation_sigma_m", &C::hand_eye_restart_translation_sigma, 1.0, 0.0,
+           100.0,
+           "least translation 1 sigma x_caml is restarted with after such a restart (the "
+           "camera is likely elsewhere too)"),
   };
   return table;
 }

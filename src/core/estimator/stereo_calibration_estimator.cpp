@@ -6,6 +6,9 @@
 
 #include <Eigen/Cholesky>
 
+#include "online_stereo_calibration/core/filter/state_layout.h"
+#include "online_stereo_calibration/core/geometry/rotation.h"
+
 namespace osc {
 namespace {
 
@@ -19,6 +22,14 @@ StereoIntrinsics stereoIntrinsics(const CameraModel& left, const CameraModel& ri
   return k;
 }
 
+HandEyeRotationConfig handEyeConfig(const FilterConfig& config) {
+  HandEyeRotationConfig h;
+  h.max_sigma = config.hand_eye_max_sigma;
+  // Five times the odometry's rotation noise per axis per step: below, no excitation.
+  h.min_rotation = 5.0 * config.motion_rotation_noise;
+  return h;
+}
+
 }  // namespace
 
 StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& config,
@@ -28,8 +39,11 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
     : config_(config),
       left_(left),
       right_(right),
-      filter_(config, stereoIntrinsics(left_, right_)) {
+      filter_(config, stereoIntrinsics(left_, right_)),
+      guess_(initial_guess),
+      mounting_(left_, handEyeConfig(config)) {
   filter_.reset(initial_guess);
+  guess_covariance_ = filter_.covariance();
   anchorHere(JumpBlock::kNone, 0.0, 0.0);
 }
 
@@ -125,6 +139,65 @@ bool StereoCalibrationEstimator::relinearizeIfMoved(FrameReport* report) {
   return true;
 }
 
+bool StereoCalibrationEstimator::restartFromMotion(
+    const MotionIncrement& motion, const std::vector<StereoObservation>& observations,
+    FrameReport* report) {
+  using namespace layout;
+  mounting_.addFrame(motion, has_previous_frame_, observations);
+  MountingRestart restart;
+  const StereoExtrinsics now = filter_.extrinsics();
+  auto covariance = filter_.covariance();
+  if (!mounting_.checkFilter(now.T_veh_caml.linear(),
+                             covariance.template block<3, 3>(kCaml + kRotation, kCaml + kRotation),
+                             config_.hand_eye_restart_distance, config_.hand_eye_min_restart_sigma,
+                             &restart)) {
+    return false;
+  }
+  // A fresh start from the guess, with the hand-eye rotation for x_caml's: everything learned
+  // so far was learned with x_caml's rotation far off (x_camr too: in the first frames the
+  // filter explains the wrong rotation's mispredictions partly with x_camr, 36 sigma off in
+  // yr after one frame with a backward camera guessed forward). A camera whose rotation was
+  // guessed this far off is likely elsewhere too (at the tailgate, under a mirror): its
+  // translation starts from the guess with at least hand_eye_restart_translation_sigma.
+  // x_camr: the guess's covariance (the config's start sigmas, or a saved calibration's).
+  StereoExtrinsics start = guess_;
+  start.T_veh_caml.linear() = restart.R_veh_caml;
+  for (const PointEstimate& p : filter_.points()) report->dropped.push_back(p.id);
+  covariance = guess_covariance_;
+  covariance.template middleRows<kPoseDim>(kCaml).setZero();
+  covariance.template middleCols<kPoseDim>(kCaml).setZero();
+  const double translation_sigma =
+      std::max(config_.initial_caml_translation_sigma, config_.hand_eye_restart_translation_sigma);
+  covariance.template block<3, 3>(kCaml + kTranslation, kCaml + kTranslation) =
+      Eigen::Matrix3d::Identity() * translation_sigma * translation_sigma;
+  covariance.template block<3, 3>(kCaml + kRotation, kCaml + kRotation) = restart.covariance;
+  filter_.reset(start, covariance);
+  anchorHere(JumpBlock::kNone, 0.0, 0.0);  // a start: both blocks re-linearised as after one
+  report->mounting_rotation_from_motion = true;
+  const Eigen::Vector3d before = rpyFromRotation(now.T_veh_caml.linear()) * 180.0 / M_PI;
+  const Eigen::Vector3d after = rpyFromRotation(restart.R_veh_caml) * 180.0 / M_PI;
+  std::ostringstream message;
+  message.precision(4);
+  message << "mounting rotation from motion: x_caml restarted from roll/pitch/yaw " << after(0)
+          << "/" << after(1) << "/" << after(2) << " deg (was " << before(0) << "/" << before(1)
+          << "/" << before(2) << " deg, " << restart.distance << " sigmas apart; hand-eye "
+          << restart.hand_eye.reason
+          << "); everything else from the guess again, translation 1 sigma " << translation_sigma
+          << " m; tracks reset";
+  report->warnings.push_back(message.str());
+  return true;
+}
+
+bool StereoCalibrationEstimator::wantsLeftCameraMatches() const {
+  return handEyeActive() && mounting_.lastMotionUsable() && !mounting_.lastFramePaired();
+}
+
+void StereoCalibrationEstimator::addLeftCameraMatches(const MotionIncrement& motion,
+                                                      const std::vector<Eigen::Vector2d>& previous,
+                                                      const std::vector<Eigen::Vector2d>& current) {
+  if (wantsLeftCameraMatches()) mounting_.addMatches(motion, previous, current);
+}
+
 bool StereoCalibrationEstimator::toMeasurement(const StereoObservation& o,
                                                PointMeasurement* m) const {
   if (!o.left_pixel.allFinite() || !o.right_pixel.allFinite() || !std::isfinite(o.sigma_left) ||
@@ -147,6 +220,9 @@ bool StereoCalibrationEstimator::toMeasurement(const StereoObservation& o,
 FrameReport StereoCalibrationEstimator::processFrame(
     const MotionIncrement& motion, const std::vector<StereoObservation>& observations) {
   FrameReport report;
+  if (handEyeActive() && restartFromMotion(motion, observations, &report)) {
+    has_previous_frame_ = false;  // tracking starts afresh with this pair, as after a start
+  }
   std::vector<PointMeasurement> tracked, candidates;
   for (const StereoObservation& o : observations) {
     PointMeasurement m;
@@ -234,6 +310,7 @@ std::vector<PointId> StereoCalibrationEstimator::resetTracking() {
   for (const PointEstimate& p : filter_.points()) dropped.push_back(p.id);
   for (PointId id : dropped) filter_.removePoint(id);
   has_previous_frame_ = false;
+  mounting_.forgetFrame();
   return dropped;
 }
 
@@ -245,13 +322,18 @@ std::vector<PointId> StereoCalibrationEstimator::reopenRightCameraRotation(doubl
 }
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
+  guess_ = guess;
+  mounting_.clear();
   filter_.reset(guess);
+  guess_covariance_ = filter_.covariance();
   has_previous_frame_ = false;
   anchorHere(JumpBlock::kNone, 0.0, 0.0);
 }
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
                                        const Matrix12d& tangent_covariance) {
+  guess_ = guess;
+  mounting_.clear();
   // The given covariance is one as estimate() reports it (a saved calibration): take out what
   // the odometry's scale adds there, so that save -> restore -> estimate() gives it back. If
   // that leaves it indefinite (a prior sharper than the odometry's scale allows, e.g. sigmas
@@ -261,6 +343,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
   filter_.reset(guess, scale.isZero() || internal.llt().info() != Eigen::Success
                            ? tangent_covariance
                            : Matrix12d(0.5 * (internal + internal.transpose())));
+  guess_covariance_ = filter_.covariance();
   has_previous_frame_ = false;
   anchorHere(JumpBlock::kNone, 0.0, 0.0);
 }

@@ -7,6 +7,7 @@
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/frontend/feature_detection.h"
 #include "online_stereo_calibration/core/frontend/global_stereo_fit.h"
+#include "online_stereo_calibration/core/frontend/left_motion_matches.h"
 #include "online_stereo_calibration/core/frontend/stereo_front_end.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
 
@@ -60,6 +61,7 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
                                             estimator_->filter(), &result.front_end);
   result.estimator = estimator_->processFrame(motion_since_last_processed, result.stereo_pairs);
   front_end_->commit(result.estimator, estimator_->filter());
+  feedHandEye(motion_since_last_processed);
   result.processed = true;
   result.status = result.estimator.motion_rejected ? "processed (motion rejected, tracks reset)"
                   : result.estimator.relinearized
@@ -95,6 +97,23 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   result.processing_time =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+void CalibrationPipeline::feedHandEye(const MotionIncrement& motion) {
+  constexpr double kRatio = 0.8;  // Lowe's ratio test
+  if (!estimator_->handEyeActive()) {
+    has_previous_left_features_ = false;
+    previous_left_features_ = FeatureSet();
+    return;
+  }
+  if (has_previous_left_features_ && estimator_->wantsLeftCameraMatches()) {
+    std::vector<Eigen::Vector2d> previous, current;
+    matchLeftFeatures(previous_left_features_, front_end_->lastLeftFeatures(),
+                      estimator_->leftCamera(), kRatio, &previous, &current);
+    estimator_->addLeftCameraMatches(motion, previous, current);
+  }
+  previous_left_features_ = front_end_->lastLeftFeatures();
+  has_previous_left_features_ = true;
 }
 
 bool CalibrationPipeline::lostTheStereoGeometry(const FrontEndStatistics& stats) {

@@ -154,6 +154,26 @@ struct FilterConfig {
 
   /// Every problem found, each naming the parameter, its value and the allowed range.
   std::vector<std::string> validate() const;
+
+  // --- hand-eye rotation at start (issue 14) ---
+  /// 1: until x_caml's rotation is determined from the motion alone (hand_eye_rotation.h),
+  /// the estimator collects the left camera's and the vehicle's motion pairs, and if the
+  /// filter's x_caml rotation disagrees with the rotation they give (a camera mounted
+  /// backwards or sideways with a forward guess) starts the filter afresh from the guess with
+  /// that rotation (mounting_from_motion.h); 0: off (the paper).
+  int hand_eye_start = 1;
+  /// rad: the hand-eye rotation counts as determined when its worst axis' 1 sigma is below.
+  double hand_eye_max_sigma = 1.5 * 0.0174532925199432958;
+  /// rad: the hand-eye rotation's 1 sigma is taken as at least this per axis, for the
+  /// comparison with the filter and for the restart (its own sigma ignores the camera's lever
+  /// arm: 2-3 deg off against 0.7 deg in the first second of the off-road drive).
+  double hand_eye_min_restart_sigma = 3.0 * 0.0174532925199432958;
+  /// Restart when the filter's rotation is farther from the hand-eye's than this Mahalanobis
+  /// distance (both covariances, 3 dof).
+  double hand_eye_restart_distance = 3.0;
+  /// m: least translation 1 sigma x_caml is restarted with (a camera whose rotation was
+  /// guessed that far off is likely elsewhere too: at the tailgate, under a mirror).
+  double hand_eye_restart_translation_sigma = 1.5;
 };
 
 /// One row of the parameter table.

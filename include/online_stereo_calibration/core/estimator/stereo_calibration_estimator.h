@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "online_stereo_calibration/core/config/filter_config.h"
+#include "online_stereo_calibration/core/estimator/mounting_from_motion.h"
 #include "online_stereo_calibration/core/estimator/types.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
 #include "online_stereo_calibration/core/geometry/camera_model.h"
@@ -59,6 +60,10 @@ struct FrameReport {
   /// Stereo pairs came, but not one point could be initialised and the filter has none (the
   /// left->right estimate triangulates none within the depth range: a baseline guess far off).
   bool no_point_initialised = false;
+  /// x_caml was restarted from its rotation determined from the vehicle's and the left
+  /// camera's motion (FilterConfig::hand_eye_start; the warning names the old and new
+  /// roll/pitch/yaw); tracks reset.
+  bool mounting_rotation_from_motion = false;
   std::vector<std::string> warnings;  ///< human-readable, one per problem
 };
 
@@ -92,6 +97,20 @@ class StereoCalibrationEstimator {
   const CalibrationFilter& filter() const { return filter_; }
   const CameraModel& leftCamera() const { return left_; }
   const CameraModel& rightCamera() const { return right_; }
+  /// The hand-eye start still collects and the last processFrame's ids gave it no pair (at
+  /// image level with x_caml far off no track survives from one pair to the next): a caller
+  /// with the images may give it the left image's own matches (addLeftCameraMatches).
+  bool wantsLeftCameraMatches() const;
+  /// Correspondences of the previous and the last processed pair's left images (normalised
+  /// coordinates, left_motion_matches.h) for the hand-eye start, with the motion given to that
+  /// processFrame. Ignored unless wantsLeftCameraMatches().
+  void addLeftCameraMatches(const MotionIncrement& motion,
+                            const std::vector<Eigen::Vector2d>& previous,
+                            const std::vector<Eigen::Vector2d>& current);
+  /// The hand-eye start is still collecting (on, rotation not yet determined).
+  bool handEyeActive() const { return config_.hand_eye_start != 0 && !mounting_.done(); }
+  /// The hand-eye start's pairs and solver (FilterConfig::hand_eye_start).
+  const MountingFromMotion& mountingFromMotion() const { return mounting_; }
 
  private:
   /// Where the filter was last started or a block re-opened (its linearisation point) and
@@ -129,6 +148,12 @@ class StereoCalibrationEstimator {
   /// than relinearization_threshold is restarted from the current estimate with the anchor's
   /// uncertainty; every point is dropped into report->dropped. True if it did.
   bool relinearizeIfMoved(FrameReport* report);
+  /// The hand-eye start (mounting_from_motion.h): feeds the frame's motion pair; once the
+  /// rotation is determined and far from x_caml's, starts the filter afresh from the guess
+  /// with that rotation for x_caml's (its translation sigma at least
+  /// hand_eye_restart_translation_sigma). True if it did (every point dropped).
+  bool restartFromMotion(const MotionIncrement& motion,
+                         const std::vector<StereoObservation>& observations, FrameReport* report);
 
   FilterConfig config_;
   CameraModel left_;
@@ -136,6 +161,10 @@ class StereoCalibrationEstimator {
   CalibrationFilter filter_;
   bool has_previous_frame_ = false;
   LinearizationAnchor anchor_;
+  /// The last start's guess and its tangent covariance (restartFromMotion starts from them).
+  StereoExtrinsics guess_;
+  Eigen::MatrixXd guess_covariance_;
+  MountingFromMotion mounting_;
 };
 
 }  // namespace osc

@@ -12,6 +12,7 @@
 
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
+#include "online_stereo_calibration/core/frontend/feature_detection.h"
 #include "online_stereo_calibration/core/frontend/front_end_config.h"
 #include "online_stereo_calibration/core/frontend/global_stereo_fit.h"
 
@@ -116,6 +117,13 @@ class CalibrationPipeline {
   /// Consecutive whole-image fits contradicting x_camr (wholeImageFitContradicts).
   int fits_contradicting_ = 0;
   GlobalStereoFit last_fit_;
+  /// The previous processed pair's left keypoints, kept while the estimator's hand-eye start
+  /// collects (feedHandEye).
+  FeatureSet previous_left_features_;
+  bool has_previous_left_features_ = false;
+  /// The hand-eye start at image level: the left images' own keypoint matches when the
+  /// estimator's tracks gave it no pair (StereoCalibrationEstimator::wantsLeftCameraMatches).
+  void feedHandEye(const MotionIncrement& motion);
 };
 
 }  // namespace osc
