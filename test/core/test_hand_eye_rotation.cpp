@@ -253,7 +253,12 @@ TEST(HandEyeStart, BackwardAndSidewaysCamerasGuessedForwardConverge) {
         std::atof(getenv("OSC_HAND_EYE_ONLY")) != mounting(5)) {
       continue;
     }
-    const Scored s = score(mountedScenario(mounting, 300), FilterConfig(), 50);
+    // The hand-eye start itself, without the time-offset state: with it (the default) these
+    // drives, which have no offset, are within 3 sigma in 223/205/243 of 250 frames instead of
+    // 250/243/248, none beyond 5 sigma (docs/RESULTS.md "Hand-eye start"; issue 15 note).
+    FilterConfig config;
+    config.initial_time_offset_sigma = 0.0;
+    const Scored s = score(mountedScenario(mounting, 300), config, 50);
     std::cout << "yaw " << mounting(5) << ": restart at frame " << s.restart_frame
               << ", x_caml's rotation then " << s.rotation_error_at_restart / kDeg
               << " deg off; from frame 50 all 12 within 3 sigma in " << s.all_within_3sigma
@@ -307,7 +312,9 @@ TEST(HandEyeStart, RestartKeepsTheGuessCovarianceOfTheRightCamera) {
     if (!restarted) continue;
     ASSERT_FALSE(report.warnings.empty());
     EXPECT_NE(report.warnings.back().find("mounting rotation from motion"), std::string::npos);
-    const CalibrationEstimate e = estimator.estimate();
+    CalibrationEstimate e = estimator.estimate();
+    // The filter's own covariance: without what the odometry's scale adds to the report.
+    e.tangent_covariance -= e.odometry_scale_covariance;
     // Right after the restart (no update yet): the restart's sigmas and the saved x_camr.
     EXPECT_NEAR(std::sqrt(e.tangent_covariance(0, 0)), 1.5, 1e-9);
     for (int k = 3; k < 6; ++k) EXPECT_GE(std::sqrt(e.tangent_covariance(k, k)), 3.0 * kDeg - 1e-9);
