@@ -100,23 +100,10 @@ int main(int argc, char** argv) {
                   << " frames at " << scenario.rate_hz << " Hz, seed " << scenario.seed << "\n";
 
         const auto on_frame = [&](const osc::ScenarioFrameResult& r) {
-          osc::EstimateRow e;
-          e.frame = r.frame;
-          e.stamp = r.stamp;
-          e.parameters = r.parameters;
-          e.sigmas = r.sigmas;
-          e.tracked_points = r.tracked_points;
-          e.time_ms = r.time_ms;
-          e.time_offset = r.time_offset;
-          e.time_offset_sigma = r.time_offset_sigma;
-          estimates.write(e);
-          estimate_rows.push_back(e);
-          osc::ReferenceRow ref;
-          ref.frame = r.frame;
-          ref.stamp = r.stamp;
-          ref.parameters = r.truth;
-          reference.write(ref);
-          reference_rows.push_back(ref);
+          estimate_rows.push_back(osc::estimateRowOf(r));
+          estimates.write(estimate_rows.back());
+          reference_rows.push_back(osc::referenceRowOf(r));
+          reference.write(reference_rows.back());
           times.push_back(r.time_ms);
           if (r.jump_detected) {
             ++jumps;
@@ -132,20 +119,12 @@ int main(int argc, char** argv) {
                          r.tracked_points);
           }
         };
-        const auto results = osc::runMeasurementScenario(scenario, config, on_frame);
+        osc::runMeasurementScenario(scenario, config, on_frame);
         estimates.flush();
         reference.flush();
 
-        osc::CalibrationFile final_calibration;
-        final_calibration.extrinsics =
-            osc::StereoExtrinsics::fromParameters(results.back().parameters);
-        final_calibration.sigmas = results.back().sigmas;
-        final_calibration.stamp = results.back().stamp;
-        if (results.back().time_offset_sigma > 0.0) {
-          final_calibration.time_offset = results.back().time_offset;
-          final_calibration.time_offset_sigma = results.back().time_offset_sigma;
-        }
-        osc::writeCalibrationFileAtomic(options.out + "/calibration.yaml", final_calibration);
+        osc::writeCalibrationFileAtomic(options.out + "/calibration.yaml",
+                                        osc::calibrationFileOf(estimate_rows.back()));
 
         std::sort(times.begin(), times.end());
         const double median = times[times.size() / 2];

@@ -125,11 +125,6 @@ TEST(OdometryScale, TheTranslationsUncertaintyCoversAScaleErrorImagesCannotTell)
   EXPECT_GT(old.max_z, 5.0);  // yr: the baseline in the odometry's (wrong) scale
 }
 
-}  // namespace
-}  // namespace osc
-
-namespace osc {
-namespace {
 
 // A saved calibration (estimate()'s covariance, scale included) restored by reset() comes back
 // as saved, not widened by the odometry's scale a second time; a prior sharper than the scale

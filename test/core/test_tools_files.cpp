@@ -164,6 +164,24 @@ TEST(CalibrationFile, TimeOffsetIsSavedAndReadBack) {
       {"neg.yaml", "sigma_time_offset"});
 }
 
+TEST(CalibrationFile, ARunsFinalRowKeepsTheTimeOffsetOnlyWhenEstimated) {
+  EstimateRow row;
+  row.parameters << 1.5, 0.1, 1.3, 0.01, 0.02, 0.03, 0.0, -0.3, 0.0, 0.001, 0.002, 0.003;
+  row.sigmas.setConstant(0.01);
+  row.stamp = 12.5;
+  row.time_offset = 0.004;
+  row.time_offset_sigma = 0.0;  // not estimated
+  const CalibrationFile without = calibrationFileOf(row);
+  EXPECT_TRUE(without.extrinsics.toParameters().isApprox(row.parameters, 1e-12));
+  EXPECT_EQ(*without.stamp, 12.5);
+  EXPECT_FALSE(without.time_offset.has_value());
+  row.time_offset_sigma = 0.001;
+  const CalibrationFile with = calibrationFileOf(row);
+  ASSERT_TRUE(with.time_offset && with.time_offset_sigma);
+  EXPECT_EQ(*with.time_offset, 0.004);
+  EXPECT_EQ(*with.time_offset_sigma, 0.001);
+}
+
 TEST(CalibrationFile, FormattedTextParsesBackBitExactForManyValues) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 200; ++trial) {

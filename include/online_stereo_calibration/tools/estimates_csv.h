@@ -2,7 +2,8 @@
 /// @brief The per-frame estimates CSV of interface.md and a reference CSV for simulated truth.
 ///
 /// Estimates (one line per processed image pair, m and rad):
-/// `frame,stamp,xl,...,yaw_r,sigma_xl,...,sigma_yaw_r,tracked_points,time_ms`.
+/// `frame,stamp,xl,...,yaw_r,sigma_xl,...,sigma_yaw_r,tracked_points,time_ms`, then the
+/// further columns `time_offset_ms,sigma_time_offset_ms`.
 /// Reference: `frame,stamp,xl,yl,zl,roll_l,pitch_l,yaw_l,xr,yr,zr,roll_r,pitch_r,yaw_r`.
 /// `stamp` is written with at least 9 decimals (more when needed to read back the same
 /// double), every other value with 17 significant digits. Readers accept further columns
@@ -16,6 +17,9 @@
 #include "online_stereo_calibration/core/geometry/pose.h"
 
 namespace osc {
+
+struct CalibrationFile;      // calibration_file.h
+struct ScenarioFrameResult;  // core/sim/scenario_runner.h
 
 /// One line of the estimates CSV.
 struct EstimateRow {
@@ -37,6 +41,14 @@ struct ReferenceRow {
   double stamp = 0;                          ///< s
   Vector12d parameters = Vector12d::Zero();  ///< true [xl..yaw_l, xr..yaw_r], m and rad
 };
+
+/// The estimates row of a simulated frame's result.
+EstimateRow estimateRowOf(const ScenarioFrameResult& result);
+/// The reference (truth) row of a simulated frame's result.
+ReferenceRow referenceRowOf(const ScenarioFrameResult& result);
+/// The calibration file of a row (the last one: a run's final calibration): extrinsics,
+/// sigmas, stamp, and the time offset when it was estimated (sigma > 0).
+CalibrationFile calibrationFileOf(const EstimateRow& row);
 
 /// Column names of the estimates CSV, in order (interface.md); the reader requires these.
 const std::vector<std::string>& estimatesCsvColumns();

@@ -26,21 +26,8 @@ CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& o
   EstimatesCsvWriter estimates(dir + "/estimates.csv");
   ReferenceCsvWriter reference(dir + "/reference.csv");
   const auto on_frame = [&](const ScenarioFrameResult& r) {
-    EstimateRow e;
-    e.frame = r.frame;
-    e.stamp = r.stamp;
-    e.parameters = r.parameters;
-    e.sigmas = r.sigmas;
-    e.tracked_points = r.tracked_points;
-    e.time_ms = r.time_ms;
-    e.time_offset = r.time_offset;
-    e.time_offset_sigma = r.time_offset_sigma;
-    estimates.write(e);
-    ReferenceRow ref;
-    ref.frame = r.frame;
-    ref.stamp = r.stamp;
-    ref.parameters = r.truth;
-    reference.write(ref);
+    estimates.write(estimateRowOf(r));
+    reference.write(referenceRowOf(r));
   };
   CampaignRow row;
   try {

@@ -8,6 +8,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "online_stereo_calibration/core/sim/scenario_runner.h"
+#include "online_stereo_calibration/tools/calibration_file.h"
+
 namespace osc {
 namespace {
 
@@ -167,6 +170,39 @@ const std::vector<std::string>& estimatesCsvColumns() {
     return c;
   }();
   return columns;
+}
+
+EstimateRow estimateRowOf(const ScenarioFrameResult& result) {
+  EstimateRow row;
+  row.frame = result.frame;
+  row.stamp = result.stamp;
+  row.parameters = result.parameters;
+  row.sigmas = result.sigmas;
+  row.tracked_points = result.tracked_points;
+  row.time_ms = result.time_ms;
+  row.time_offset = result.time_offset;
+  row.time_offset_sigma = result.time_offset_sigma;
+  return row;
+}
+
+ReferenceRow referenceRowOf(const ScenarioFrameResult& result) {
+  ReferenceRow row;
+  row.frame = result.frame;
+  row.stamp = result.stamp;
+  row.parameters = result.truth;
+  return row;
+}
+
+CalibrationFile calibrationFileOf(const EstimateRow& row) {
+  CalibrationFile file;
+  file.extrinsics = StereoExtrinsics::fromParameters(row.parameters);
+  file.sigmas = row.sigmas;
+  file.stamp = row.stamp;
+  if (row.time_offset_sigma > 0.0) {
+    file.time_offset = row.time_offset;
+    file.time_offset_sigma = row.time_offset_sigma;
+  }
+  return file;
 }
 
 const std::vector<std::string>& estimatesCsvFurtherColumns() {

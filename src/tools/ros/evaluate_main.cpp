@@ -294,15 +294,8 @@ int evaluateBag(const Options& options) {
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  osc::CalibrationFile final_calibration;
-  final_calibration.extrinsics = osc::StereoExtrinsics::fromParameters(estimates.back().parameters);
-  final_calibration.sigmas = estimates.back().sigmas;
-  final_calibration.stamp = estimates.back().stamp;
-  if (estimates.back().time_offset_sigma > 0.0) {
-    final_calibration.time_offset = estimates.back().time_offset;
-    final_calibration.time_offset_sigma = estimates.back().time_offset_sigma;
-  }
-  osc::writeCalibrationFileAtomic(options.out + "/calibration.yaml", final_calibration);
+  osc::writeCalibrationFileAtomic(options.out + "/calibration.yaml",
+                                  osc::calibrationFileOf(estimates.back()));
 
   const osc::Percentiles timing = osc::percentiles(times);
   std::ostringstream text;
