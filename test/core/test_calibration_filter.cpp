@@ -77,17 +77,19 @@ Matrix12d guessCovariance(double scale = 1.0) {
   return (scale * sigma).array().square().matrix().asDiagonal();
 }
 
-/// The dense reference holds the calibration and the points only: no odometry states.
-FilterConfig configWithoutOdometryStates() {
+/// The dense reference holds the calibration and the points only, as positions: no odometry
+/// states, no inverse depth.
+FilterConfig configOfTheDenseReference() {
   FilterConfig config;
   config.initial_time_offset_sigma = 0.0;
   config.odometry_velocity_bias_sigma = 0.0;
+  config.inverse_depth_points = 0;
   return config;
 }
 
 void expectFiltersAgree(MotionNoiseModel model) {
   SmallProblem problem(6, 6);
-  FilterConfig config = configWithoutOdometryStates();
+  FilterConfig config = configOfTheDenseReference();
   config.motion_noise_model = model;
   CalibrationFilter structured(config, problem.K);
   DenseCalibrationUkf dense(config, problem.K);
@@ -150,7 +152,7 @@ TEST(CalibrationFilter, NewPointCrossCovarianceMatchesMonteCarlo) {
   // SUT through triangulation. Check both against sampling the same inputs.
   SmallProblem problem(1, 1);
   problem.world = {Eigen::Vector3d(7.0, 0.5, 1.0)};     // 5.5 m ahead: depth still near-Gaussian
-  FilterConfig config = configWithoutOdometryStates();  // the joint below is [12, point]
+  FilterConfig config = configOfTheDenseReference();  // the joint below is [12, point]
   CalibrationFilter filter(config, problem.K);
   filter.reset(problem.guess, guessCovariance());
   PointMeasurement m = problem.measure(0, 0.0).front();

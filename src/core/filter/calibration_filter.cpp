@@ -161,7 +161,11 @@ bool samePreviousMotions(const std::vector<MotionIncrement>& a,
 }  // namespace
 
 CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoIntrinsics& intrinsics)
-    : config_(config), excitation_(config), intrinsics_(intrinsics), monitor_(config) {
+    : config_(config),
+      excitation_(config),
+      coordinates_(config.inverse_depth_points != 0),
+      intrinsics_(intrinsics),
+      monitor_(config) {
   const std::vector<std::string> problems = config.validate();
   if (!problems.empty()) {
     std::string message = "invalid filter configuration:";
@@ -355,7 +359,12 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
       if (o > 0) motion_error = motion_jacobian * x.segment(6, o);
       if (shared) motion_error += x.segment<6>(6 + o);
       const Eigen::Isometry3d T_prev_curr = boxPlus(T_motion, motion_error);
-      *y = predictPoint(mean + x.tail<3>(), T_veh_lopt, T_prev_curr, x.head<3>(), R_excited);
+      const HomogeneousPoint moved =
+          predictHomogeneousPoint(coordinates_.homogeneous(mean + x.tail<3>()), T_veh_lopt,
+                                  T_prev_curr, x.head<3>(), R_excited);
+      Eigen::Vector3d coordinates;
+      if (!coordinates_.fromHomogeneous(moved, &coordinates)) return false;
+      *y = coordinates;
       return true;
     };
     UnscentedResult ut;
@@ -367,11 +376,13 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
     const Eigen::Matrix3d F_p = ut.jacobian.rightCols<3>();
     MatrixXd B = F_p * point.B;
     for (int a = 0; a < s; ++a) B.col(selected[a]) += ut.jacobian.col(a);
-    Eigen::Matrix3d Q = sigma_p2 * Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d Q = sigma_p2 * Eigen::Matrix3d::Identity();  // of the position
     if (!shared)
       Q = paperPointProcessNoise(
-          mean, sigma_imu,
+          coordinates_.position(mean, minInverseDepth()), sigma_imu,
           config_.point_position_noise * std::sqrt(noiseScale(config_, motion.dt)));
+    const Eigen::Matrix3d J = coordinates_.jacobianFromPosition(ut.mean);
+    Q = J * Q * J.transpose();
     point.D = F_p * point.D * F_p.transpose() + ut.residual + Q;
     point.D = 0.5 * (point.D + point.D.transpose());
     point.B = B;
@@ -656,7 +667,8 @@ bool CalibrationFilter::linearizeMeasurement(size_t i, const MatrixXd& P, const 
     const Eigen::Isometry3d T_ropt_lopt =
         leftToRightOptical(boxPlus(extrinsics_.T_caml_camr, x.head<6>())).inverse();
     Eigen::Vector4d projected;
-    if (!projectStereo(point.mean + x.tail<3>(), T_ropt_lopt, intrinsics_, 1e-3, &projected))
+    if (!projectHomogeneousStereo(coordinates_.homogeneous(point.mean + x.tail<3>()), T_ropt_lopt,
+                                  intrinsics_, 1e-3, &projected))
       return false;
     *y = projected;
     return true;
@@ -724,8 +736,10 @@ std::vector<PredictedObservation> CalibrationFilter::predictObservations(
     prediction.id = scratch.points_[i].id;
     prediction.z = inn.predicted;
     prediction.S = inn.S;
-    const double depth_before = points_[i].mean.z(), depth_after = scratch.points_[i].mean.z();
-    if (depth_before > 0.0 && depth_after > 0.0)
+    const double depth_before = coordinates_.depth(points_[i].mean);
+    const double depth_after = coordinates_.depth(scratch.points_[i].mean);
+    if (depth_before > 0.0 && depth_after > 0.0 && std::isfinite(depth_before) &&
+        std::isfinite(depth_after))
       prediction.depth_ratio = depth_before / depth_after;
     predictions.push_back(prediction);
   }
@@ -841,6 +855,13 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
   const VectorFunction triangulate = [&](const VectorXd& x, VectorXd* y) {
     const Eigen::Isometry3d T_lopt_ropt =
         leftToRightOptical(boxPlus(extrinsics_.T_caml_camr, x.head<6>()));
+    if (coordinates_.inverseDepth()) {
+      // Any disparity has an inverse depth: a sigma point beyond infinity is still one.
+      const auto c = triangulateInverseDepth(m.z + x.tail<4>(), T_lopt_ropt, intrinsics_);
+      if (!c || c->z() > 2.0 / min_depth) return false;
+      *y = *c;
+      return true;
+    }
     const auto p = triangulateStereo(m.z + x.tail<4>(), T_lopt_ropt, intrinsics_);
     if (!p || p->z() < 0.5 * min_depth || p->z() > 2.0 * max_depth) return false;
     *y = *p;
@@ -848,7 +869,8 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
   };
   UnscentedResult ut;
   if (!unscentedTransformWithFallback(VectorXd::Zero(10), C, triangulate, ut_, &ut)) return false;
-  if (ut.mean.z() < min_depth || ut.mean.z() > max_depth) return false;
+  const double depth = coordinates_.depth(ut.mean);
+  if (!(depth >= min_depth && depth <= max_depth)) return false;
   TrackedPoint point;
   point.id = m.id;
   point.mean = ut.mean;
@@ -882,8 +904,16 @@ std::vector<PointEstimate> CalibrationFilter::points() const {
   for (const TrackedPoint& point : points_) {
     PointEstimate e;
     e.id = point.id;
-    e.position_lopt = point.mean;
-    e.covariance = point.B * covariance_ * point.B.transpose() + point.D;
+    e.position_lopt = coordinates_.position(point.mean, minInverseDepth());
+    // Cov(position) = J^-1 Cov(c) J^-T, J = d c / d position (a far point: clamped as above).
+    Eigen::Matrix3d J_inverse = Eigen::Matrix3d::Identity();
+    if (coordinates_.inverseDepth()) {
+      Eigen::Vector3d clamped = point.mean;
+      clamped.z() = std::max(clamped.z(), minInverseDepth());
+      J_inverse = coordinates_.jacobianFromPosition(clamped).inverse();
+    }
+    e.covariance =
+        J_inverse * (point.B * covariance_ * point.B.transpose() + point.D) * J_inverse.transpose();
     result.push_back(e);
   }
   return result;

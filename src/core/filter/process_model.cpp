@@ -24,6 +24,21 @@ Eigen::Vector3d predictPoint(const Eigen::Vector3d& point_lopt, const Eigen::Iso
          T_veh_lopt.linear().transpose() * (lever_change * position_error);
 }
 
+Eigen::Vector4d predictHomogeneousPoint(const Eigen::Vector4d& point_lopt,
+                                        const Eigen::Isometry3d& T_veh_lopt,
+                                        const Eigen::Isometry3d& T_prev_curr,
+                                        const Eigen::Vector3d& position_error,
+                                        const Eigen::Matrix3d& R_excited) {
+  // p -> A p + c with A the rotation of eq. 7-8 and c = the image of the origin.
+  const Eigen::Vector3d c =
+      predictPoint(Eigen::Vector3d::Zero(), T_veh_lopt, T_prev_curr, position_error, R_excited);
+  const Eigen::Matrix3d A =
+      T_veh_lopt.linear().transpose() * T_prev_curr.linear().transpose() * T_veh_lopt.linear();
+  Eigen::Vector4d moved;
+  moved << A * point_lopt.head<3>() + c * point_lopt.w(), point_lopt.w();
+  return moved;
+}
+
 MotionTwists twistsAtEnds(const std::vector<MotionIncrement>& earlier,
                           const MotionIncrement& current) {
   MotionTwists twists;

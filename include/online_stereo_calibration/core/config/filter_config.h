@@ -72,6 +72,10 @@ struct FilterConfig {
   double min_point_depth = 1.0;   ///< m
   double max_point_depth = 80.0;  ///< m
   int max_points = 150;           ///< points kept in the state
+  /// 1: points are stored as inverse depth (x/z, y/z, 1/z) in the left optical frame, whose
+  /// uncertainty stays close to Gaussian while the depth is +-100 % uncertain (a new point
+  /// under a wide x_camr prior, a far point); 0: as positions (x, y, z), the seed's choice.
+  int inverse_depth_points = 1;
 
   // --- input sanity ---
   double max_speed = 70.0;          ///< m/s; a motion increment faster than this is rejected

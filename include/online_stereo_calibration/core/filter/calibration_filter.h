@@ -27,6 +27,7 @@
 #include "online_stereo_calibration/core/filter/consistency_monitor.h"
 #include "online_stereo_calibration/core/filter/measurement_model.h"
 #include "online_stereo_calibration/core/filter/motion_excitation.h"
+#include "online_stereo_calibration/core/filter/point_coordinates.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/filter/unscented_transform.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
@@ -134,7 +135,8 @@ class CalibrationFilter {
   Eigen::Vector3d velocityBiasSigma() const;
   std::vector<PointEstimate> points() const;
   /// The full (P + 3N)^2 covariance the structured form represents (P = 12 + the odometry
-  /// states), points in the order of points(). For tests and diagnostics; O(N^2).
+  /// states), points in the order of points() and in the filter's point coordinates
+  /// (FilterConfig::inverse_depth_points). For tests and diagnostics; O(N^2).
   Eigen::MatrixXd denseCovariance() const;
 
   /// The consistency monitor's state: per-block statistics and the drift-noise factors.
@@ -146,7 +148,7 @@ class CalibrationFilter {
  private:
   struct TrackedPoint {
     PointId id = 0;
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();  ///< in coordinates_
     Eigen::MatrixXd B;  ///< 3 x G regression on the global error
     Eigen::Matrix3d D = Eigen::Matrix3d::Zero();
   };
@@ -154,6 +156,9 @@ class CalibrationFilter {
   struct Prediction;       // defined in the .cpp
 
   std::string checkMotion(const MotionIncrement& motion) const;
+  /// The inverse depth (1/m) below which a point is placed, where a position is needed (its
+  /// process noise, points()): half that of the farthest new point.
+  double minInverseDepth() const { return 0.5 / config_.max_point_depth; }
   /// Size of the persistent global error: calibration (12) + odometry states.
   int persistentDim() const { return layout::kCalibrationDim + odometry_dim_; }
   double stateSigma(int index) const {
@@ -206,6 +211,7 @@ class CalibrationFilter {
   /// kTwistTrendIncrements (twistsAtEnds).
   std::vector<MotionIncrement> previous_motions_;
   MotionExcitation excitation_;
+  PointCoordinates coordinates_;  ///< how TrackedPoint::mean stores a point
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;
   StereoExtrinsics extrinsics_;

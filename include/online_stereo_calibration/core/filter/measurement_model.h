@@ -22,6 +22,22 @@ struct StereoIntrinsics {
 bool projectStereo(const Eigen::Vector3d& point_lopt, const Eigen::Isometry3d& T_ropt_lopt,
                    const StereoIntrinsics& intrinsics, double min_depth, Eigen::Vector4d* z);
 
+/// The same for a homogeneous point [d; w] (position d / w, point_coordinates.h). A point at
+/// or beyond infinity (w <= 0) projects by its direction d, which must be in front of both.
+bool projectHomogeneousStereo(const Eigen::Vector4d& point_lopt,
+                              const Eigen::Isometry3d& T_ropt_lopt,
+                              const StereoIntrinsics& intrinsics, double min_depth,
+                              Eigen::Vector4d* z);
+
+/// Inverse-depth triangulation of an undistorted stereo measurement z: the direction (a, b)
+/// = (x/z, y/z) of the left pixel's ray and the inverse depth rho = 1/z that best puts the
+/// point on the right pixel (linear least squares on the right image's two coordinates).
+/// Defined for any disparity, also a negative one (rho < 0, a noisy far point); empty only
+/// if the right pixel gives no information on rho (the rays are parallel for every depth).
+std::optional<Eigen::Vector3d> triangulateInverseDepth(const Eigen::Vector4d& z,
+                                                       const Eigen::Isometry3d& T_lopt_ropt,
+                                                       const StereoIntrinsics& intrinsics);
+
 /// Midpoint triangulation of an undistorted stereo measurement z; empty if the rays do not
 /// meet in front of both cameras.
 std::optional<Eigen::Vector3d> triangulateStereo(const Eigen::Vector4d& z,

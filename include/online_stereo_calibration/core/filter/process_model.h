@@ -28,6 +28,15 @@ Eigen::Vector3d predictPoint(const Eigen::Vector3d& point_lopt, const Eigen::Iso
                              const Eigen::Vector3d& position_error,
                              const Eigen::Matrix3d& R_excited);
 
+/// The same for a homogeneous point [d; w] (position d / w, point_coordinates.h): the motion
+/// is affine in the position, p -> A p + c, so [d; w] -> [A d + c w; w], defined also for a
+/// point at infinity (w = 0).
+Eigen::Vector4d predictHomogeneousPoint(const Eigen::Vector4d& point_lopt,
+                                        const Eigen::Isometry3d& T_veh_lopt,
+                                        const Eigen::Isometry3d& T_prev_curr,
+                                        const Eigen::Vector3d& position_error,
+                                        const Eigen::Matrix3d& R_excited);
+
 /// The vehicle's body twist [v (3), w (3)] (m/s, rad/s, in the vehicle frame at that
 /// instant) at the start and at the end of one motion increment.
 struct MotionTwists {
