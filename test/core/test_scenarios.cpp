@@ -156,6 +156,8 @@ MeasurementScenario hoveringSmallRigScenario() {
 // re-looks at a static point "measure" the baseline), (b) the prediction linearised at the
 // measured translation (noise, bilinear with depth) and (c) with a 2 deg x_camr rotation
 // prior, point depths +-100 % uncertain, so the UT of the first re-looks fakes yaw_r.
+// Inverse-depth points (the default since) remove (c): yr ends 5.4 / 2.6 sigma off with a
+// sigma of 1.3-1.5 mm (rotation priors 0.2 / 2 deg); (a) and (b) remain.
 TEST(Observability, DISABLED_HoveringSmallRigDoesNotLearnItsBaseline) {
   for (const double rotation_sigma_deg : {0.2, 2.0}) {
     FilterConfig config;
@@ -175,9 +177,10 @@ TEST(Observability, DISABLED_HoveringSmallRigDoesNotLearnItsBaseline) {
 // small sigma (yaw_r 176 sigma off, all 12 within 3 sigma in 0 % of the frames, seed 1).
 // Restarting from the current estimate with the start's covariance while the estimate still
 // moves far from where the filter was started and its innovations show the bad
-// linearisation (FilterConfig::relinearization_*) keeps it honest: measured share 0.93 / 0.95
-// / 0.97 and max z 10.0 / 7.3 / 3.5 (seeds 1-3, with the consistency monitor on) against
-// 0.00 / 0.17 / 0.00 and 176 / 36 / 39 without.
+// linearisation (FilterConfig::relinearization_*) keeps it honest. Measured, seeds 1-3, with
+// inverse-depth points: share 1.00 / 0.995 / 0.997, max z 2.8 / 3.0 / 3.0; without the
+// restart 0.00 / 0.53 / 0.58 and 10.6 / 9.0 / 10.2 (xl). (Points as positions: with 0.98 /
+// 0.97 / 0.98 and 3.7 / 4.8 / 3.5; without 45 / 4.5 / 40.)
 TEST(Start, FarOffRightCameraAnglesAreRelinearisedNotLockedIn) {
   MeasurementScenario scenario = paperOffroadScenario();
   scenario.frames = 400;
@@ -189,12 +192,12 @@ TEST(Start, FarOffRightCameraAnglesAreRelinearisedNotLockedIn) {
   for (unsigned seed : {1u, 2u, 3u}) {
     scenario.seed = seed;
     const CampaignScore with = scoreCampaignRun(runMeasurementScenario(scenario, FilterConfig()));
-    EXPECT_GE(with.share_within_3sigma, 0.85) << "seed " << seed;
-    EXPECT_LT(with.max_z, 12.0) << "seed " << seed;
+    EXPECT_GE(with.share_within_3sigma, 0.95) << "seed " << seed;
+    EXPECT_LT(with.max_z, 5.0) << "seed " << seed;
     const CampaignScore old = scoreCampaignRun(runMeasurementScenario(scenario, without));
     worst_without = std::max(worst_without, old.max_z);
   }
-  EXPECT_GT(worst_without, 30.0);  // the case the re-linearisation is for
+  EXPECT_GT(worst_without, 8.0);  // the case the re-linearisation is for
 }
 
 // Issue 14: an 11 cm rig guessed at 1 cm (yr +0.1 m) gets no point at all (every stereo pair
