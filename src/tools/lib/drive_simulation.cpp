@@ -85,7 +85,7 @@ double DriveSimulator::frameStamp(int frame) const {
 
 Eigen::Isometry3d DriveSimulator::truePose(double t) const {
   if (analytic_) return analytic_->pose(t);
-  const auto pose = recorded_->at(recorded_start_ + t, 1e-9);
+  const auto pose = recorded_->smoothAt(recorded_start_ + t, 1e-9);  // as MeasurementSimulator
   if (!pose) throw std::out_of_range("DriveSimulator: time outside the recorded trajectory");
   return *pose;
 }
