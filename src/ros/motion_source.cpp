@@ -82,14 +82,15 @@ void MotionSource::odomCallback(const nav_msgs::Odometry::ConstPtr& message) {
 }
 
 void MotionSource::reportTwist(const std::string& problem) {
-  if (!problem.empty()) ++samples_without_twist;
-  // Said when it starts and when it changes, not for every sample of a driver without twists.
-  if (problem == last_twist_problem_) return;
+  const bool changed = problem != last_twist_problem_;
   last_twist_problem_ = problem;
   if (problem.empty()) return;
+  ++samples_without_twist;
   const std::string why =
       "odometry " + problem + ": the time offset uses the trend of earlier increments there";
-  ROS_WARN("online_stereo_calibration: %s", why.c_str());
+  // Counted in the diagnostics for every sample; logged when it starts or changes, not for
+  // every sample of an odometry without twists.
+  if (changed) ROS_WARN("online_stereo_calibration: %s", why.c_str());
   if (on_problem) on_problem("odometry without twist", why);
 }
 
