@@ -111,6 +111,22 @@ SimulatedImagePair DriveSimulator::renderFrame(int frame) const {
   return out;
 }
 
+Vector6d DriveSimulator::odometryTwist(double stamp) const {
+  const double t =
+      stamp - scenario_.rendering.start_stamp + scenario_.measurement.odometry_error.time_offset;
+  constexpr double h = 1e-3;  // s, central difference of the true pose
+  double from = t - h, to = t + h;
+  if (recorded_) {  // one-sided at the ends of the recording
+    from = std::max(from, recorded_->firstStamp() - recorded_start_);
+    to = std::min(to, recorded_->lastStamp() - recorded_start_);
+  }
+  const Eigen::Isometry3d motion =
+      analytic_ ? analytic_->motionBetween(from, to) : truePose(from).inverse() * truePose(to);
+  Vector6d twist = logSE3(motion) / (to - from);
+  twist.head<3>() *= 1.0 + scenario_.measurement.odometry_error.scale_error;
+  return twist;
+}
+
 std::vector<StampedPose> DriveSimulator::odometry() const {
   const double period = 1.0 / scenario_.rendering.odom_rate_hz;
   const double end = (frames_ - 1) / scenario_.measurement.rate_hz + period;
