@@ -115,6 +115,41 @@ std::string poseProblem(const geometry_msgs::Pose& pose) {
   return "";
 }
 
+StampedPose odometrySample(const nav_msgs::Odometry& message, bool with_covariance,
+                           std::string* twist_problem, std::string* covariance_problem) {
+  StampedPose sample{message.header.stamp.toSec(), isometryFromPose(message.pose.pose)};
+  const geometry_msgs::Twist& t = message.twist.twist;
+  sample.twist << t.linear.x, t.linear.y, t.linear.z, t.angular.x, t.angular.y, t.angular.z;
+  sample.has_twist = sample.twist.allFinite();
+  if (!sample.has_twist) {
+    sample.twist.setZero();
+    *twist_problem = "twist not finite";
+  }
+  if (with_covariance) {
+    Eigen::Matrix<double, 6, 6> c;
+    for (int r = 0; r < 6; ++r)
+      for (int k = 0; k < 6; ++k)
+        c(r, k) = message.twist.covariance[static_cast<size_t>(6 * r + k)];
+    // Many drivers leave it zero, or mark it unknown with -1.
+    const bool usable = c.allFinite() && c.diagonal().minCoeff() >= 0.0 &&
+                        c.diagonal().maxCoeff() > 0.0 &&
+                        (c - c.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * c.cwiseAbs().maxCoeff();
+    sample.has_twist_covariance = usable;
+    if (usable) sample.twist_covariance = c;
+    if (!usable)
+      *covariance_problem = "twist covariance not finite, negative, asymmetric or all zero";
+  }
+  return sample;
+}
+
+std::string unsetTwistProblem(const StampedPose& sample, const StampedPose& previous) {
+  if (!sample.has_twist || !sample.twist.isZero(0.0)) return "";
+  const Eigen::Isometry3d moved = previous.pose.inverse() * sample.pose;
+  const double angle = Eigen::AngleAxisd(moved.linear()).angle();
+  if (moved.translation().norm() <= 1e-3 && angle <= 1e-3) return "";
+  return "twist exactly zero while the pose moved (not filled in by the odometry?)";
+}
+
 Eigen::Isometry3d interpolatePose(const StampedPose& before, const StampedPose& after,
                                   double stamp) {
   const double span = after.stamp - before.stamp;

@@ -70,6 +70,23 @@ LookupStatus PoseBuffer::poseAt(double stamp, Eigen::Isometry3d* pose) const {
   return LookupStatus::kOk;
 }
 
+bool PoseBuffer::twistAt(double stamp, osc::Vector6d* twist) const {
+  if (samples_.empty() || !(stamp >= samples_.front().stamp && stamp <= samples_.back().stamp))
+    return false;
+  auto after = std::lower_bound(samples_.begin(), samples_.end(), stamp,
+                                [](const StampedPose& s, double t) { return s.stamp < t; });
+  if (after->stamp == stamp) {
+    if (after->has_twist) *twist = after->twist;
+    return after->has_twist;
+  }
+  auto before = after - 1;
+  if (after->stamp - before->stamp > max_gap_ || !before->has_twist || !after->has_twist)
+    return false;
+  const double s = (stamp - before->stamp) / (after->stamp - before->stamp);
+  *twist = (1.0 - s) * before->twist + s * after->twist;
+  return true;
+}
+
 bool PoseBuffer::incrementCovariance(double from, double to,
                                      Eigen::Matrix<double, 6, 6>* covariance) const {
   if (samples_.size() < 2 || !(to > from) || from < samples_.front().stamp ||

@@ -28,30 +28,21 @@ void MotionSource::odomCallback(const nav_msgs::Odometry::ConstPtr& message) {
     if (on_problem) on_problem("rejected odometry", why);
     return;
   }
-  StampedPose sample{message->header.stamp.toSec(), isometryFromPose(message->pose.pose)};
-  if (config_.use_odometry_covariance) {
-    // Usable: finite, symmetric, non-negative variances and not all zero (many drivers
-    // leave it zero, or mark it unknown with -1). Else no covariance for this sample.
-    Eigen::Matrix<double, 6, 6> c;
-    for (int r = 0; r < 6; ++r)
-      for (int k = 0; k < 6; ++k)
-        c(r, k) = message->twist.covariance[static_cast<size_t>(6 * r + k)];
-    const bool usable = c.allFinite() && c.diagonal().minCoeff() >= 0.0 &&
-                        c.diagonal().maxCoeff() > 0.0 &&
-                        (c - c.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * c.cwiseAbs().maxCoeff();
-    sample.has_twist_covariance = usable;
-    if (usable) sample.twist_covariance = c;
-    if (!usable && on_problem) {
-      on_problem("unusable odometry covariance",
-                 "twist covariance not finite, negative, asymmetric or all zero: the configured "
-                 "motion noise is used for this interval");
-    }
+  std::string twist_problem, covariance_problem;
+  StampedPose sample = odometrySample(*message, config_.use_odometry_covariance, &twist_problem,
+                                      &covariance_problem);
+  if (!covariance_problem.empty() && on_problem) {
+    on_problem("unusable odometry covariance",
+               covariance_problem + ": the configured motion noise is used for this interval");
   }
   PoseBuffer::Offered offered;
   double newest = 0.0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     newest = poses_.newestStamp();
+    if (twist_problem.empty() && poses_.newest())
+      twist_problem = unsetTwistProblem(sample, *poses_.newest());
+    if (!twist_problem.empty()) sample.has_twist = false;
     offered = poses_.offer(sample);
     if (offered == PoseBuffer::Offered::kRestarted) gyro_.clear();
   }
@@ -86,7 +77,21 @@ void MotionSource::odomCallback(const nav_msgs::Odometry::ConstPtr& message) {
       return;
     }
   }
+  reportTwist(twist_problem);
   if (on_odom) on_odom();
+}
+
+void MotionSource::reportTwist(const std::string& problem) {
+  const bool changed = problem != last_twist_problem_;
+  last_twist_problem_ = problem;
+  if (problem.empty()) return;
+  ++samples_without_twist;
+  const std::string why =
+      "odometry " + problem + ": the time offset uses the trend of earlier increments there";
+  // Counted in the diagnostics for every sample; logged when it starts or changes, not for
+  // every sample of an odometry without twists.
+  if (changed) ROS_WARN("online_stereo_calibration: %s", why.c_str());
+  if (on_problem) on_problem("odometry without twist", why);
 }
 
 void MotionSource::imuCallback(const sensor_msgs::Imu::ConstPtr& message) {
@@ -137,6 +142,14 @@ LookupStatus MotionSource::motionBetween(const ros::Time& previous, const ros::T
   motion->T_prev_curr = pose_previous.inverse() * pose_current;
   motion->dt = (current - previous).toSec();
   motion->has_covariance = false;
+  // The odometry's own twists at both stamps for the time offset (tf has none: the filter
+  // then takes the trend of the earlier increments).
+  motion->has_twists = false;
+  if (config_.motion_source == MotionSourceType::kOdom) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    motion->has_twists = poses_.twistAt(previous.toSec(), &motion->twist_start) &&
+                         poses_.twistAt(current.toSec(), &motion->twist_end);
+  }
   if (config_.use_odometry_covariance && config_.motion_source == MotionSourceType::kOdom &&
       !config_.use_imu) {
     std::lock_guard<std::mutex> lock(mutex_);

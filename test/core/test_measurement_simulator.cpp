@@ -867,6 +867,40 @@ std::shared_ptr<const PoseTrajectory> recordingOf(const VehicleMotionProfile& pr
   return std::make_shared<const PoseTrajectory>(poses);
 }
 
+// Issue 15: a recorded drive's twists must be the derivative of its pose, also across the
+// recorded samples; at()'s linear pieces jump there, smoothAt() does not.
+TEST(PoseTrajectory, SmoothAtPassesThroughThePosesWithContinuousVelocityAndRate) {
+  VehicleMotionProfile profile;
+  profile.speed = 6.0;
+  profile.yaw_rate_amplitude = 0.4;
+  const VehicleTrajectory analytic(profile);
+  const std::shared_ptr<const PoseTrajectory> recording = recordingOf(profile, 5.0);
+  const auto twist = [](const auto& poseAt, double t0, double t1) -> Vector6d {
+    return logSE3(poseAt(t0).inverse() * poseAt(t1)) / (t1 - t0);
+  };
+  const auto smooth = [&recording](double t) { return *recording->smoothAt(t); };
+  const auto linear = [&recording](double t) { return *recording->at(t); };
+  const double h = 1e-5;
+  double smooth_jump = 0.0, linear_jump = 0.0, smooth_error = 0.0, linear_error = 0.0;
+  for (int k = 1; k < 99; ++k) {
+    const double t = 1000.0 + 0.05 * k;
+    ASSERT_TRUE(smooth(t).isApprox(recording->poses()[k].pose, 1e-12)) << "sample " << k;
+    // The twist just before and just after the sample.
+    smooth_jump = std::max(smooth_jump, (twist(smooth, t - h, t) - twist(smooth, t, t + h)).norm());
+    linear_jump = std::max(linear_jump, (twist(linear, t - h, t) - twist(linear, t, t + h)).norm());
+    // Between samples, against the drive that was recorded.
+    const double between = t + 0.02;
+    smooth_error += boxMinus(smooth(between), analytic.pose(between - 1000.0)).norm();
+    linear_error += boxMinus(linear(between), analytic.pose(between - 1000.0)).norm();
+  }
+  EXPECT_LT(smooth_jump, 1e-3);  // m/s + rad/s: only the finite difference's own error
+  EXPECT_GT(linear_jump, 0.05);  // 6 m/s, 0.4 rad/s of steering: the twist turns by 0.1
+  EXPECT_LT(smooth_error, 0.2 * linear_error);
+  // The ends and outside behave as at().
+  EXPECT_TRUE(recording->smoothAt(1000.0)->isApprox(*recording->at(1000.0), 1e-12));
+  EXPECT_FALSE(recording->smoothAt(999.0).has_value());
+}
+
 TEST(MeasurementSimulator, RecordedTrajectoryGivesTheInterpolatedPoses) {
   VehicleMotionProfile recorded_motion;
   recorded_motion.speed = 6.0;
@@ -881,11 +915,11 @@ TEST(MeasurementSimulator, RecordedTrajectoryGivesTheInterpolatedPoses) {
   const PoseTrajectory& file = *s.recorded_trajectory;
   for (const SimulatedFrame& f : runAll(&sim)) {
     const double stamp = 1000.0 + 3.3 + f.index / 15.0;
-    ASSERT_TRUE(f.T_world_veh.isApprox(*file.at(stamp), 1e-12)) << "frame " << f.index;
+    ASSERT_TRUE(f.T_world_veh.isApprox(*file.smoothAt(stamp), 1e-12)) << "frame " << f.index;
     EXPECT_TRUE(sim.truePose(f.stamp).matrix() == f.T_world_veh.matrix());
     if (f.index == 0) continue;
     const Eigen::Isometry3d shifted =
-        file.at(stamp - 1.0 / 15.0 - 0.2)->inverse() * *file.at(stamp - 0.2);
+        file.smoothAt(stamp - 1.0 / 15.0 - 0.2)->inverse() * *file.smoothAt(stamp - 0.2);
     ASSERT_TRUE(f.measured_motion.T_prev_curr.isApprox(shifted, 1e-12)) << "frame " << f.index;
   }
   // Observations follow the recorded poses (exact projections of static points).

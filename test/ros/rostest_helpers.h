@@ -312,7 +312,8 @@ class RenderedDrive {
   /// Publishes the odometry samples not yet published with stamps up to @p until (s).
   void publishOdometryUntil(double until) {
     while (next_odom_ < odometry_.size() && odometry_[next_odom_].stamp <= until) {
-      odom_.publish(osc::bag::toOdometry(odometry_[next_odom_], names_));
+      const osc::StampedPose& sample = odometry_[next_odom_];
+      odom_.publish(osc::bag::toOdometry(sample, simulator_->odometryTwist(sample.stamp), names_));
       ++next_odom_;
     }
   }

@@ -175,6 +175,45 @@ TEST(DriveSimulation, AShortenedDriveIsTheBeginningOfTheFullOne) {
   EXPECT_NE(osc::scenarioFingerprint(scenario, 5), osc::scenarioFingerprint(scenario, 300));
 }
 
+// Issue 15: an odometry bag whose twist is all zero while the vehicle moves (a driver, or an
+// older `simulate`, that does not fill it) gives no twists, with the reason; a NaN twist
+// none around it; the others are read.
+TEST(BagTools, OdometryTwistsAreReadUnlessUnset) {
+  char dir_template[] = "/tmp/osc_bag_twists_XXXXXX";
+  const std::string path = std::string(mkdtemp(dir_template)) + "/odom.bag";
+  const osc::bag::DriveTopics names;
+  for (const bool unset : {true, false}) {
+    {
+      rosbag::Bag bag(path, rosbag::bagmode::Write);
+      for (int k = 0; k < 20; ++k) {
+        const double t = 100.0 + 0.05 * k;
+        osc::Vector6d twist = osc::Vector6d::Zero();
+        if (!unset) twist << 4.0 + 0.1 * k, 0.0, 0.0, 0.0, 0.0, 0.2;
+        if (!unset && k == 12) twist(5) = std::nan("");
+        const nav_msgs::Odometry m =
+            osc::bag::toOdometry({t, pose(0.2 * k, 0, 0, 0, 0, 0.01 * k)}, twist, names);
+        bag.write("/odom", m.header.stamp, m);
+      }
+    }
+    rosbag::Bag bag(path, rosbag::bagmode::Read);
+    const osc::bag::OdometryAndCalibration read =
+        osc::bag::readOdometryAndCalibration(bag, "/odom", "");
+    osc::Vector6d twist;
+    if (unset) {
+      EXPECT_EQ(read.samples_without_twist, 19);  // the first has nothing to compare with
+      EXPECT_NE(read.twist_problem.find("zero"), std::string::npos) << read.twist_problem;
+      EXPECT_FALSE(read.odometry_twists.twistAt(100.52, &twist));
+    } else {
+      EXPECT_EQ(read.samples_without_twist, 1);
+      EXPECT_NE(read.twist_problem.find("not finite"), std::string::npos) << read.twist_problem;
+      ASSERT_TRUE(read.odometry_twists.twistAt(100.225, &twist));
+      EXPECT_NEAR(twist(0), 4.45, 1e-9);
+      EXPECT_NEAR(twist(5), 0.2, 1e-12);
+      EXPECT_FALSE(read.odometry_twists.twistAt(100.57, &twist));
+    }
+  }
+}
+
 TEST(BagTools, SimulateThenEvaluateShortDrive) {
   const std::string simulate = findTool("simulate");
   const std::string evaluate = findTool("evaluate");
@@ -213,6 +252,20 @@ TEST(BagTools, SimulateThenEvaluateShortDrive) {
     const osc::PoseTrajectory odom = osc::bag::readOdometry(bag, "/odom");
     EXPECT_GE(odom.lastStamp(), reference.back().stamp);
     EXPECT_LE(odom.firstStamp(), reference.front().stamp);
+    // Issue 15: the odometry carries the vehicle's twist, which `evaluate` reads at the image
+    // stamps; it agrees with the (noisy) odometry poses' own mean motion over 1 s.
+    const osc::bag::OdometryAndCalibration read =
+        osc::bag::readOdometryAndCalibration(bag, "/odom", "");
+    EXPECT_EQ(read.samples_without_twist, 0) << read.twist_problem;
+    for (int k : {10, 30, 49}) {
+      osc::Vector6d twist;
+      ASSERT_TRUE(read.odometry_twists.twistAt(reference[k].stamp, &twist)) << "frame " << k;
+      const auto mean = odom.motionBetween(reference[k].stamp - 0.5, reference[k].stamp + 0.5);
+      ASSERT_TRUE(mean.has_value());
+      const osc::Vector6d mean_twist = osc::logSE3(mean->T_prev_curr) / mean->dt;
+      EXPECT_NEAR(twist(0), mean_twist(0), 0.1 * std::abs(mean_twist(0))) << "frame " << k;
+      EXPECT_GT(twist(0), 1.0);  // forward, at the paper's few m/s
+    }
   }
   const osc::CalibrationFile truth_file = osc::readCalibrationFile(dir + "/sim/truth.yaml");
   EXPECT_TRUE(truth_file.extrinsics.toParameters().isApprox(reference[0].parameters, 1e-12));

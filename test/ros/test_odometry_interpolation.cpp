@@ -92,6 +92,88 @@ TEST(PoseBuffer, IncrementCovarianceSumsTheTwistCovariancesOverTheInterval) {
   EXPECT_TRUE(buffer.incrementCovariance(1.1, 1.2, &covariance));
 }
 
+/// The odometry message of a vehicle that speeds up (2 m/s + 1.5 m/s^2 t) along its x axis
+/// while turning at 0.3 rad/s: body twist [2 + 1.5 t, 0, 0, 0, 0, 0.3], linear in t. The pose
+/// is truthAt's (only its movement matters here).
+nav_msgs::Odometry acceleratingTurn(double t) {
+  nav_msgs::Odometry m;
+  m.header.stamp.fromSec(t);
+  const geometry_msgs::Transform pose = transformFromIsometry(truthAt(t));
+  m.pose.pose.position.x = pose.translation.x;
+  m.pose.pose.position.y = pose.translation.y;
+  m.pose.pose.position.z = pose.translation.z;
+  m.pose.pose.orientation = pose.rotation;
+  m.twist.twist.linear.x = 2.0 + 1.5 * t;
+  m.twist.twist.angular.z = 0.3;
+  return m;
+}
+
+osc::Vector6d acceleratingTurnTwist(double t) {
+  osc::Vector6d twist;
+  twist << 2.0 + 1.5 * t, 0.0, 0.0, 0.0, 0.0, 0.3;
+  return twist;
+}
+
+// Issue 15: the twists of an increment (at both image stamps) come from the odometry's own
+// twist.twist, interpolated between the messages around each stamp, as MotionSource does.
+TEST(PoseBuffer, IncrementTwistsAreTheOdometrysTwistsAtTheImageStamps) {
+  PoseBuffer buffer(10.0, 0.5);
+  for (int i = 0; i <= 50; ++i) {  // 50 Hz
+    std::string twist_problem, covariance_problem;
+    const StampedPose sample =
+        odometrySample(acceleratingTurn(1.0 + 0.02 * i), true, &twist_problem, &covariance_problem);
+    EXPECT_TRUE(sample.has_twist);
+    EXPECT_EQ(twist_problem, "");
+    EXPECT_FALSE(sample.has_twist_covariance);  // all zero: not given
+    EXPECT_NE(covariance_problem, "");
+    if (buffer.newest()) EXPECT_EQ(unsetTwistProblem(sample, *buffer.newest()), "");
+    ASSERT_TRUE(buffer.add(sample));
+  }
+  // Image stamps between odometry stamps, and on one.
+  for (double stamp : {1.013, 1.113, 1.6, 1.987}) {
+    osc::Vector6d twist;
+    ASSERT_TRUE(buffer.twistAt(stamp, &twist)) << stamp;
+    EXPECT_LT((twist - acceleratingTurnTwist(stamp)).norm(), 1e-12) << stamp;
+  }
+  osc::Vector6d twist;
+  EXPECT_FALSE(buffer.twistAt(2.01, &twist));  // not yet covered
+  EXPECT_FALSE(buffer.twistAt(0.99, &twist));
+}
+
+// A twist that is not finite, or all zero while the pose moves (a driver that does not fill
+// it), is not used: increments touching it get none (the filter then uses the trend), and the
+// reason is said.
+TEST(PoseBuffer, UnusableTwistsGiveNoIncrementTwists) {
+  PoseBuffer buffer(10.0, 0.5);
+  std::string twist_problem, covariance_problem, nan_problem;
+  for (int i = 0; i <= 5; ++i) {
+    nav_msgs::Odometry m = acceleratingTurn(1.0 + 0.02 * i);
+    if (i == 3) m.twist.twist.angular.y = std::numeric_limits<double>::quiet_NaN();
+    twist_problem.clear();
+    const StampedPose sample = odometrySample(m, false, &twist_problem, &covariance_problem);
+    EXPECT_EQ(sample.has_twist, i != 3);
+    EXPECT_EQ(twist_problem.empty(), i != 3);
+    if (i == 3) nan_problem = twist_problem;
+    ASSERT_TRUE(buffer.add(sample));
+  }
+  EXPECT_EQ(covariance_problem, "");  // not asked for
+  EXPECT_NE(nan_problem.find("not finite"), std::string::npos) << nan_problem;
+  osc::Vector6d twist;
+  EXPECT_TRUE(buffer.twistAt(1.03, &twist));
+  EXPECT_FALSE(buffer.twistAt(1.05, &twist));  // between samples 2 and 3
+  EXPECT_FALSE(buffer.twistAt(1.06, &twist));  // sample 3 itself
+  EXPECT_FALSE(buffer.twistAt(1.07, &twist));
+  EXPECT_TRUE(buffer.twistAt(1.09, &twist));
+  // All zero: unset while the vehicle moves, a real standstill while it does not.
+  nav_msgs::Odometry zero = acceleratingTurn(1.12);
+  zero.twist.twist = geometry_msgs::Twist();
+  const StampedPose unset = odometrySample(zero, false, &twist_problem, &covariance_problem);
+  EXPECT_NE(unsetTwistProblem(unset, *buffer.newest()), "");
+  StampedPose standing = unset;
+  standing.pose = buffer.newest()->pose;
+  EXPECT_EQ(unsetTwistProblem(standing, *buffer.newest()), "");
+}
+
 // Issue 17: one stale odometry message must not wipe the history; a time line that really
 // went back (a bag loop) is adopted after PoseBuffer::kSamplesToRestart samples.
 TEST(PoseBuffer, OneStaleSampleIsRefusedButANewTimeLineIsAdopted) {

@@ -7,6 +7,7 @@
 
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Transform.h>
+#include <nav_msgs/Odometry.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <Eigen/Geometry>
@@ -63,7 +64,25 @@ struct StampedPose {
   /// (nav_msgs/Odometry twist.covariance, vehicle frame), when the odometry gives a usable one.
   bool has_twist_covariance = false;
   Eigen::Matrix<double, 6, 6> twist_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  /// The body twist [v (m/s), w (rad/s)] of the vehicle (the odometry's child frame) at this
+  /// stamp (nav_msgs/Odometry twist.twist), when the odometry gives a usable one: the time
+  /// offset's model (osc::MotionIncrement::has_twists) uses it.
+  bool has_twist = false;
+  osc::Vector6d twist = osc::Vector6d::Zero();
 };
+
+/// The sample of a nav_msgs/Odometry message whose pose is usable (poseProblem): header
+/// stamp, pose.pose, twist.twist (has_twist when all six values are finite, else
+/// @p twist_problem says why) and, with @p with_covariance, twist.covariance when it is
+/// usable (finite, symmetric, non-negative variances, not all zero; else
+/// @p covariance_problem says why). Problems not met are left "".
+StampedPose odometrySample(const nav_msgs::Odometry& message, bool with_covariance,
+                           std::string* twist_problem, std::string* covariance_problem);
+
+/// Why @p sample's twist looks unset ("" if it does not): exactly zero in all six values
+/// while the pose moved since @p previous (by > 1 mm or 1 mrad). Drivers that do not fill
+/// the twist leave it zero; a moving vehicle's own estimate is never exactly zero.
+std::string unsetTwistProblem(const StampedPose& sample, const StampedPose& previous);
 
 /// The pose at @p stamp between @p before and @p after: translation linear, rotation SLERP
 /// (shortest arc). @p stamp may be outside [before, after] (extrapolation); equal stamps

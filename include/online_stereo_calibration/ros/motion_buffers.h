@@ -68,6 +68,13 @@ class PoseBuffer {
   /// interval is not covered).
   bool incrementCovariance(double from, double to, Eigen::Matrix<double, 6, 6>* covariance) const;
 
+  /// The twist at @p stamp, linear between the two samples bracketing it (a sample's own at
+  /// its stamp). False if the stamp is not covered, the samples are further apart than
+  /// max_gap, or either has no twist (StampedPose::has_twist).
+  bool twistAt(double stamp, osc::Vector6d* twist) const;
+
+  /// The newest sample, or nullptr.
+  const StampedPose* newest() const { return samples_.empty() ? nullptr : &samples_.back(); }
   bool empty() const { return samples_.empty(); }
   double newestStamp() const { return samples_.empty() ? 0.0 : samples_.back().stamp; }
 

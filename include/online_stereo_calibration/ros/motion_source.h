@@ -44,11 +44,16 @@ class MotionSource {
   std::function<void(const std::string& kind, const std::string& message)> on_problem;
   /// Samples ignored (non-finite, duplicated or out-of-order stamps).
   std::atomic<int> rejected_samples{0};
+  /// Odometry samples used without their twist (not finite, or unset: unsetTwistProblem);
+  /// increments touching them get no twists (the time offset then uses the trend).
+  std::atomic<int> samples_without_twist{0};
 
  private:
   void odomCallback(const nav_msgs::Odometry::ConstPtr& message);
   void imuCallback(const sensor_msgs::Imu::ConstPtr& message);
   LookupStatus poseAt(const ros::Time& stamp, Eigen::Isometry3d* pose);
+  /// Counts a sample without twist and says why when the reason starts or changes.
+  void reportTwist(const std::string& problem);
 
   RosConfig config_;
   tf2_ros::Buffer* tf_;
@@ -57,6 +62,7 @@ class MotionSource {
   GyroIntegrator gyro_;
   ros::Subscriber odom_sub_;
   ros::Subscriber imu_sub_;
+  std::string last_twist_problem_;  ///< odometry callback only
 };
 
 }  // namespace online_stereo_calibration

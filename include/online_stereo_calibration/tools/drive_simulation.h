@@ -66,6 +66,11 @@ class DriveSimulator {
   /// against the truth), and each true increment gets the scale error and the Gauss-Markov
   /// biases (OdometryErrorProcess, seeded with the scenario seed) before the white noise.
   std::vector<StampedPose> odometry() const;
+  /// The body twist [v (m/s), w (rad/s)] (vehicle frame) the odometry reports with its
+  /// sample stamped @p stamp (ROS): the true twist at drive time
+  /// stamp - start_stamp + time_offset, the translation times 1 + scale_error, as
+  /// MeasurementSimulator::measuredTwist. For nav_msgs/Odometry twist.twist.
+  Vector6d odometryTwist(double stamp) const;
 
   const SimulationScenario& scenario() const { return scenario_; }
   const CameraModel& leftCamera() const { return left_; }

@@ -58,8 +58,9 @@ MeasurementSimulator::MeasurementSimulator(const MeasurementScenario& scenario)
 
 Eigen::Isometry3d MeasurementSimulator::truePose(double t) const {
   if (!recorded_) return trajectory_.pose(t);
+  // C1 through the recorded poses: the odometry's twists are its derivative (issue 15).
   const std::optional<Eigen::Isometry3d> pose =
-      recorded_->at(recorded_start_ + t, kRecordedTolerance);
+      recorded_->smoothAt(recorded_start_ + t, kRecordedTolerance);
   if (!pose) {
     throw std::out_of_range("MeasurementSimulator::truePose: t = " + std::to_string(t) +
                             " s lies outside the recorded trajectory");
@@ -90,7 +91,7 @@ std::vector<Eigen::Vector2d> MeasurementSimulator::groundTrack() const {
   for (const StampedPose& p : recorded_->poses()) {
     if (p.stamp > recorded_start_ && p.stamp < end) track.push_back(p.pose.translation().head<2>());
   }
-  track.push_back(recorded_->at(end, kRecordedTolerance)->translation().head<2>());
+  track.push_back(recorded_->smoothAt(end, kRecordedTolerance)->translation().head<2>());
   return track;
 }
 

@@ -85,7 +85,7 @@ double DriveSimulator::frameStamp(int frame) const {
 
 Eigen::Isometry3d DriveSimulator::truePose(double t) const {
   if (analytic_) return analytic_->pose(t);
-  const auto pose = recorded_->at(recorded_start_ + t, 1e-9);
+  const auto pose = recorded_->smoothAt(recorded_start_ + t, 1e-9);  // as MeasurementSimulator
   if (!pose) throw std::out_of_range("DriveSimulator: time outside the recorded trajectory");
   return *pose;
 }
@@ -109,6 +109,22 @@ SimulatedImagePair DriveSimulator::renderFrame(int frame) const {
   options.noise_seed += 1u;
   out.right = renderer_->render(right_, T_world_ropt, options);
   return out;
+}
+
+Vector6d DriveSimulator::odometryTwist(double stamp) const {
+  const double t =
+      stamp - scenario_.rendering.start_stamp + scenario_.measurement.odometry_error.time_offset;
+  constexpr double h = 1e-3;  // s, central difference of the true pose
+  double from = t - h, to = t + h;
+  if (recorded_) {  // one-sided at the ends of the recording
+    from = std::max(from, recorded_->firstStamp() - recorded_start_);
+    to = std::min(to, recorded_->lastStamp() - recorded_start_);
+  }
+  const Eigen::Isometry3d motion =
+      analytic_ ? analytic_->motionBetween(from, to) : truePose(from).inverse() * truePose(to);
+  Vector6d twist = logSE3(motion) / (to - from);
+  twist.head<3>() *= 1.0 + scenario_.measurement.odometry_error.scale_error;
+  return twist;
 }
 
 std::vector<StampedPose> DriveSimulator::odometry() const {

@@ -20,8 +20,9 @@ namespace {
 /// Version of the simulator's output; part of the cache fingerprint.
 // Not bumped for stops, odometry errors and blind frames: they are keys of the scenario text
 // (part of the fingerprint), and a drive without them is bit-identical to before.
-constexpr const char* kSimulatorVersion =
-    "simulate-3";  // 2: scene along the whole drive, 3: dead-reckoned odometry
+// 2: scene along the whole drive, 3: dead-reckoned odometry, 4: the odometry's twists, recorded
+// drives on a C1 curve (issue 15)
+constexpr const char* kSimulatorVersion = "simulate-4";
 
 /// Collects problems instead of stopping at the first.
 struct Problems {

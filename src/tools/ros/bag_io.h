@@ -24,6 +24,7 @@
 #include "online_stereo_calibration/core/geometry/pose.h"
 #include "online_stereo_calibration/core/geometry/pose_interpolation.h"
 #include "online_stereo_calibration/ros/conversions.h"
+#include "online_stereo_calibration/ros/motion_buffers.h"
 
 namespace osc::bag {
 
@@ -78,8 +79,9 @@ inline online_stereo_calibration::StereoCalibration toCalibrationMessage(
   return msg;
 }
 
-/// nav_msgs/Odometry of a pose (twist left zero: `evaluate` uses poses only).
-inline nav_msgs::Odometry toOdometry(const StampedPose& pose, const DriveTopics& names) {
+/// nav_msgs/Odometry of a pose and its body twist [v, w] (vehicle frame; covariances zero).
+inline nav_msgs::Odometry toOdometry(const StampedPose& pose, const Vector6d& twist,
+                                     const DriveTopics& names) {
   nav_msgs::Odometry msg;
   msg.header.stamp.fromSec(pose.stamp);
   msg.header.frame_id = names.odom_frame;
@@ -89,6 +91,12 @@ inline nav_msgs::Odometry toOdometry(const StampedPose& pose, const DriveTopics&
   msg.pose.pose.position.y = t.translation.y;
   msg.pose.pose.position.z = t.translation.z;
   msg.pose.pose.orientation = t.rotation;
+  msg.twist.twist.linear.x = twist(0);
+  msg.twist.twist.linear.y = twist(1);
+  msg.twist.twist.linear.z = twist(2);
+  msg.twist.twist.angular.x = twist(3);
+  msg.twist.twist.angular.y = twist(4);
+  msg.twist.twist.angular.z = twist(5);
   return msg;
 }
 
@@ -96,6 +104,13 @@ inline nav_msgs::Odometry toOdometry(const StampedPose& pose, const DriveTopics&
 struct OdometryAndCalibration {
   /// Every pose of the odometry topic, in stamp order (out-of-order messages are sorted).
   PoseTrajectory odometry;
+  /// The same samples with their twists (twist.twist, for the time offset), as the node
+  /// keeps them: a twist not finite or unset (online_stereo_calibration::unsetTwistProblem)
+  /// is not used. twistAt() interpolates them at any stamp.
+  online_stereo_calibration::PoseBuffer odometry_twists{1e300, 1e300};
+  /// Odometry messages whose twist is not used, and the last reason.
+  int samples_without_twist = 0;
+  std::string twist_problem;
   /// The parameters of every StereoCalibration message: (header stamp in ns, parameters), in
   /// bag order.
   std::vector<std::pair<std::int64_t, Vector12d>> calibration;
@@ -112,14 +127,17 @@ inline OdometryAndCalibration readOdometryAndCalibration(const rosbag::Bag& bag,
     if (!topic.empty()) topics.push_back(topic);
   }
   OdometryAndCalibration out;
-  std::vector<StampedPose> poses;
+  std::vector<online_stereo_calibration::StampedPose> poses;
   rosbag::View view(bag, rosbag::TopicQuery(topics));
   for (const rosbag::MessageInstance& m : view) {
     if (!odom_topic.empty() && m.getTopic() == odom_topic) {
       const auto odom = m.instantiate<nav_msgs::Odometry>();
-      if (odom)
-        poses.push_back({odom->header.stamp.toSec(),
-                         online_stereo_calibration::isometryFromPose(odom->pose.pose)});
+      std::string twist_problem, covariance_problem;
+      if (odom) {
+        poses.push_back(online_stereo_calibration::odometrySample(*odom, false, &twist_problem,
+                                                                  &covariance_problem));
+        if (!twist_problem.empty()) out.twist_problem = twist_problem;
+      }
     }
     if (!calibration_topic.empty() && m.getTopic() == calibration_topic) {
       const auto msg = m.instantiate<online_stereo_calibration::StereoCalibration>();
@@ -129,9 +147,21 @@ inline OdometryAndCalibration readOdometryAndCalibration(const rosbag::Bag& bag,
       out.calibration.emplace_back(static_cast<std::int64_t>(msg->header.stamp.toNSec()), p);
     }
   }
+  using Sample = online_stereo_calibration::StampedPose;
   std::stable_sort(poses.begin(), poses.end(),
-                   [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
-  for (const StampedPose& p : poses) out.odometry.append(p.stamp, p.pose);
+                   [](const Sample& a, const Sample& b) { return a.stamp < b.stamp; });
+  for (Sample& p : poses) {
+    out.odometry.append(p.stamp, p.pose);
+    if (const Sample* previous = out.odometry_twists.newest()) {
+      const std::string unset = online_stereo_calibration::unsetTwistProblem(p, *previous);
+      if (!unset.empty()) {
+        p.has_twist = false;
+        out.twist_problem = unset;
+      }
+    }
+    if (!p.has_twist) ++out.samples_without_twist;
+    out.odometry_twists.add(p);  // of a duplicated stamp, the first twist is kept
+  }
   return out;
 }
 

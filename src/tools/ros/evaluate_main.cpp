@@ -177,6 +177,7 @@ int evaluateBag(const Options& options) {
   osc::bag::OdometryAndCalibration inputs =
       osc::bag::readOdometryAndCalibration(bag, topics.odom, options.truth_topic);
   const osc::PoseTrajectory odometry = std::move(inputs.odometry);
+  const online_stereo_calibration::PoseBuffer& odometry_twists = inputs.odometry_twists;
   std::map<std::int64_t, osc::Vector12d> truth;  // the latest message of a stamp wins
   for (const auto& [stamp, parameters] : inputs.calibration) truth[stamp] = parameters;
   if (odometry.size() < 2)
@@ -198,6 +199,11 @@ int evaluateBag(const Options& options) {
             << topics.left_image << ", " << odometry.size() << " odometry poses on " << topics.odom
             << ", " << left_camera.width << "x" << left_camera.height << ", "
             << config.front_end.detector << " front end\n";
+  if (inputs.samples_without_twist > 0) {
+    std::cerr << "evaluate: " << inputs.samples_without_twist << " of " << odometry.size()
+              << " odometry messages without a usable twist (" << inputs.twist_problem
+              << "): the time offset uses the trend of earlier increments there\n";
+  }
 
   osc::EstimatesCsvWriter estimates_csv(options.out + "/estimates.csv");
   std::vector<osc::EstimateRow> estimates;
@@ -238,6 +244,9 @@ int evaluateBag(const Options& options) {
       const auto increment = odometry.motionBetween(previous_stamp, stamp, kOdomTolerance);
       if (increment) {
         motion = *increment;
+        // The odometry's own twists at both stamps for the time offset, as the node does.
+        motion.has_twists = odometry_twists.twistAt(previous_stamp, &motion.twist_start) &&
+                            odometry_twists.twistAt(stamp, &motion.twist_end);
       } else {
         std::cerr << "\nevaluate: no odometry around pair " << frame << " (stamp " << stamp
                   << "); tracking restarts\n";

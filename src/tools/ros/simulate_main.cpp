@@ -90,7 +90,8 @@ int simulateDrive(const Options& options) {
   scenario_message.data = "fingerprint: " + fingerprint + "\n" + scenario.source_text;
   bag.write(names.scenario, start_time, scenario_message);
   for (const osc::StampedPose& pose : simulator.odometry()) {
-    const nav_msgs::Odometry odom = osc::bag::toOdometry(pose, names);
+    const nav_msgs::Odometry odom =
+        osc::bag::toOdometry(pose, simulator.odometryTwist(pose.stamp), names);
     bag.write(names.odom, odom.header.stamp, odom);
   }
 

@@ -44,6 +44,14 @@ class PoseTrajectory {
   /// tolerance the end pose is returned) or the sequence is empty.
   std::optional<Eigen::Isometry3d> at(double stamp, double tolerance = 0.0) const;
 
+  /// As at(), but a C1 curve through the samples: cubic Hermite per interval, in the world
+  /// translation and in the rotation's tangent space at the interval's start (R_a Exp(phi(s))),
+  /// with Catmull-Rom tangents (central differences over the neighbouring samples; one-sided
+  /// at both ends). Velocity and angular rate are continuous at the samples, as a vehicle's
+  /// are, where at()'s linear pieces jump: the simulators use it for recorded drives, whose
+  /// twists must be the derivative of the pose over a time offset (issue 15).
+  std::optional<Eigen::Isometry3d> smoothAt(double stamp, double tolerance = 0.0) const;
+
   /// Motion of the body from stamp @p from to stamp @p to: T_prev_curr = T(from)^-1 * T(to),
   /// dt = to - from. Nothing if either pose is unavailable (see at()) or to <= from.
   std::optional<MotionIncrement> motionBetween(double from, double to,

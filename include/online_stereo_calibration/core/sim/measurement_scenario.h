@@ -160,8 +160,8 @@ struct MeasurementScenario {
   double moving_point_speed = 2.0;
   /// A recorded trajectory (T_world_veh over time, e.g. a TUM file read with
   /// tools/tum_trajectory.h) that replaces `motion` when set: frame k is taken at
-  /// recorded_start_offset + k / rate_hz after its first stamp, interpolated linearly +
-  /// SLERP (PoseTrajectory::at). It must hold >= 2 poses and cover every frame, shifted
+  /// recorded_start_offset + k / rate_hz after its first stamp, on a C1 curve through the
+  /// poses (PoseTrajectory::smoothAt). It must hold >= 2 poses and cover every frame, shifted
   /// by odometry_error.time_offset too (validate() names frames / recorded_start_offset).
   std::shared_ptr<const PoseTrajectory> recorded_trajectory;
   /// s after the recorded trajectory's first stamp at which frame 0 is taken, >= 0.

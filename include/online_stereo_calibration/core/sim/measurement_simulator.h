@@ -81,7 +81,8 @@ class MeasurementSimulator {
 
   /// True vehicle pose T_world_veh at drive time t (s, 0 at frame 0; any t for the analytic
   /// profile). With a recorded_trajectory: its pose at firstStamp + recorded_start_offset + t
-  /// (linear + SLERP). @throws std::out_of_range if t lies outside the recording.
+  /// (PoseTrajectory::smoothAt: C1, so that the twists below are the derivative of the pose
+  /// over any time offset). @throws std::out_of_range if t lies outside the recording.
   Eigen::Isometry3d truePose(double t) const;
   /// True motion T_veh(t0)_veh(t1) = truePose(t0)^-1 * truePose(t1); exactly the identity
   /// while the vehicle stands in a stop.
