@@ -336,7 +336,7 @@ Matrix12d withRightCamera(Matrix12d covariance, const Matrix6d& block) {
 }  // namespace
 
 std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
-    const Eigen::Isometry3d& T_caml_camr, const Matrix6d& covariance) {
+    const Eigen::Isometry3d& T_caml_camr, const Matrix6d& covariance, bool start) {
   std::vector<PointId> dropped;
   for (const PointEstimate& p : filter_.points()) dropped.push_back(p.id);
   StereoExtrinsics seeded = filter_.extrinsics();
@@ -346,7 +346,12 @@ std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
   guess_covariance_ = withRightCamera(Matrix12d(guess_covariance_), covariance);
   has_previous_frame_ = false;
   mounting_.forgetFrame();
-  anchorHere(JumpBlock::kNone, 0.0, 0.0);  // re-linearised as after a start
+  if (start) {
+    anchorHere(JumpBlock::kNone, 0.0, 0.0);
+  } else {
+    anchorHere(JumpBlock::kLeftToRight, std::sqrt(covariance.diagonal().head<3>().maxCoeff()),
+               std::sqrt(covariance.diagonal().tail<3>().maxCoeff()));
+  }
   return dropped;
 }
 

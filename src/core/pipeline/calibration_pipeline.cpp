@@ -33,6 +33,7 @@ CalibrationPipeline::CalibrationPipeline(const FilterConfig& filter_config,
       filter_config_(filter_config) {
   stereo_fit_attempts_left_ =
       filter_config_.stereo_fit_start ? filter_config_.stereo_fit_attempts : 0;
+  stereo_fit_after_reopening_ = false;
 }
 
 CalibrationPipeline::~CalibrationPipeline() = default;
@@ -110,6 +111,12 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
     estimator_->reopenRightCameraRotation(rotation_sigma);
     restartFrontEnd();
     result.right_camera_reopened = true;
+    // The next pairs' whole-image fit re-seeds the re-opened rotation (its wide sigma is no
+    // evidence for the old mean, and the fit linearises the filter near the new one).
+    if (filter_config_.stereo_fit_start) {
+      stereo_fit_attempts_left_ = filter_config_.stereo_fit_attempts;
+      stereo_fit_after_reopening_ = true;
+    }
     result.status = why +
                     ": x_camr's rotation re-opened (a knocked right camera?), tracking "
                     "restarted";
@@ -212,19 +219,24 @@ bool CalibrationPipeline::seedRightRotationFromFit(std::string* message) {
   --stereo_fit_attempts_left_;
   if (!last_seed_.valid) return false;
   stereo_fit_attempts_left_ = 0;  // one valid fit per start
-  if (!(last_seed_.distance > filter_config_.stereo_fit_restart_distance)) return false;
+  const bool after_reopening = stereo_fit_after_reopening_;
+  stereo_fit_after_reopening_ = false;
+  if (!after_reopening && !(last_seed_.distance > filter_config_.stereo_fit_restart_distance)) {
+    return false;
+  }
   const Eigen::Vector3d before = rpyFromRotation(estimate.T_caml_camr.linear()) * 180.0 / M_PI;
   const Eigen::Vector3d after = rpyFromRotation(last_seed_.T_caml_camr.linear()) * 180.0 / M_PI;
   const Eigen::Vector3d sigma =
       last_seed_.covariance.diagonal().tail<3>().cwiseSqrt() * 180.0 / M_PI;
-  estimator_->reseedRightCamera(last_seed_.T_caml_camr, last_seed_.covariance);
+  estimator_->reseedRightCamera(last_seed_.T_caml_camr, last_seed_.covariance, !after_reopening);
   std::ostringstream text;
   text.precision(3);
-  text << "right camera rotation from the stereo fit: x_camr's roll/pitch/yaw re-seeded at "
-       << after(0) << "/" << after(1) << "/" << after(2) << " deg (1 sigma " << sigma(0) << "/"
-       << sigma(1) << "/" << sigma(2) << " deg; was " << before(0) << "/" << before(1) << "/"
-       << before(2) << " deg, " << last_seed_.distance << " sigmas and "
-       << last_seed_.angle * 180.0 / M_PI << " deg apart; whole-image fit " << last_fit_.why
+  text << "right camera rotation from the stereo fit: x_camr's roll/pitch/yaw re-seeded "
+       << (after_reopening ? "after its re-opening " : "") << "at " << after(0) << "/" << after(1)
+       << "/" << after(2) << " deg (1 sigma " << sigma(0) << "/" << sigma(1) << "/" << sigma(2)
+       << " deg; was " << before(0) << "/" << before(1) << "/" << before(2) << " deg, "
+       << last_seed_.distance << " sigmas and " << last_seed_.angle * 180.0 / M_PI
+       << " deg apart; whole-image fit " << last_fit_.why
        << "); baseline direction refined with the guess's as prior, its length kept; tracks "
           "reset";
   *message = text.str();
@@ -246,6 +258,7 @@ void CalibrationPipeline::reset(const StereoExtrinsics& guess) {
   restartFrontEnd();
   stereo_fit_attempts_left_ =
       filter_config_.stereo_fit_start ? filter_config_.stereo_fit_attempts : 0;
+  stereo_fit_after_reopening_ = false;
 }
 
 void CalibrationPipeline::reset(const StereoExtrinsics& guess,
@@ -254,6 +267,7 @@ void CalibrationPipeline::reset(const StereoExtrinsics& guess,
   restartFrontEnd();
   stereo_fit_attempts_left_ =
       filter_config_.stereo_fit_start ? filter_config_.stereo_fit_attempts : 0;
+  stereo_fit_after_reopening_ = false;
 }
 
 CalibrationEstimate CalibrationPipeline::estimate() const { return estimator_->estimate(); }

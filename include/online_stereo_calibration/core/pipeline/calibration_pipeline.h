@@ -100,10 +100,11 @@ class CalibrationPipeline {
   /// Forgets the front end's tracks and the counts below (the estimator's points are the
   /// caller's to drop).
   void restartFrontEnd();
-  /// The stereo fit at a start (FilterConfig::stereo_fit_start): fits the last pair over the
-  /// whole images and, if x_camr's rotation is farther from the fit's than
-  /// stereo_fit_restart_distance, re-seeds it from the fit (rightRotationSeed). True if it
-  /// did; @p message then says what changed. A valid fit ends the start's attempts.
+  /// The stereo fit at a start or after a re-opening of x_camr's rotation
+  /// (FilterConfig::stereo_fit_start): fits the last pair over the whole images and, if
+  /// x_camr's rotation is farther from the fit's than stereo_fit_restart_distance (after a
+  /// re-opening: always), re-seeds x_camr from the fit (rightRotationSeed). True if it did;
+  /// @p message then says what changed. A valid fit ends the attempts.
   bool seedRightRotationFromFit(std::string* message);
   /// Counts pairs in which no stereo pair was found although both images had features; true
   /// (a knocked right camera) from the second in a row.
@@ -131,6 +132,9 @@ class CalibrationPipeline {
   RightRotationSeed last_seed_;
   /// Pairs left in which the stereo fit at a start is tried (0: none pending).
   int stereo_fit_attempts_left_ = 0;
+  /// The pending fit follows a re-opening of x_camr's rotation: its first valid fit re-seeds
+  /// whatever the distance.
+  bool stereo_fit_after_reopening_ = false;
   FilterConfig filter_config_;
   /// The previous processed pair's left keypoints, kept while the estimator's hand-eye start
   /// collects (feedHandEye).
