@@ -54,6 +54,12 @@ TEST(RightRotationSeed, ConvertsTheOpticalFitToTheBodyRotationAndMeasuresTheDist
   // The least sigma is added in quadrature.
   const RightRotationSeed floored = rightRotationSeed(fit, guess, P, 0.2 * kDeg);
   EXPECT_NEAR(floored.covariance(3, 3), std::pow(0.1 * kDeg, 2) + std::pow(0.2 * kDeg, 2), 1e-15);
+  // ... and about the axis across the baseline and the view (optical y, body z: yaw_r) the
+  // along-lines sigma.
+  const RightRotationSeed along = rightRotationSeed(fit, guess, P, 0.0, 1.0 * kDeg);
+  EXPECT_NEAR(along.covariance(5, 5), std::pow(0.1 * kDeg, 2) + std::pow(1.0 * kDeg, 2), 1e-12);
+  EXPECT_NEAR(along.covariance(3, 3), std::pow(0.1 * kDeg, 2), 1e-8);
+  EXPECT_NEAR(along.covariance(4, 4), std::pow(0.1 * kDeg, 2), 1e-8);
   EXPECT_FALSE(rightRotationSeed(GlobalStereoFit(), guess, P, 0.0).valid);
 }
 
@@ -187,8 +193,15 @@ TEST(StereoFitStart, DISABLED_Report) {
   cases.push_back({"baseline 50 % long", e});
   std::cout << "| start | fit | seed | re-seeded at | within 3 sigma from frame 30 | max z | "
                "x_camr at the end |\n|---|---|---|---|---|---|---|\n";
-  for (const Case& c : cases) {
+  // OSC_STEREO_FIT_ON: only off (0) or on (1); OSC_STEREO_FIT_CASE: only case k (0-3).
+  const int only_on = getenv("OSC_STEREO_FIT_ON") ? std::atoi(getenv("OSC_STEREO_FIT_ON")) : -1;
+  const int only_case =
+      getenv("OSC_STEREO_FIT_CASE") ? std::atoi(getenv("OSC_STEREO_FIT_CASE")) : -1;
+  for (size_t k = 0; k < cases.size(); ++k) {
+    if (only_case >= 0 && static_cast<int>(k) != only_case) continue;
+    const Case& c = cases[k];
     for (int on = 0; on <= 1; ++on) {
+      if (only_on >= 0 && on != only_on) continue;
       for (int seed = 1; seed <= seeds; ++seed) {
         const StartRun r = runStart(c.error, frames, on, static_cast<unsigned>(seed));
         std::printf("| %s | %s | %d | %s | %.2f | %.1f | %.1f mm, %.3f deg |\n", c.name,

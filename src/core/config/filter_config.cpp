@@ -175,7 +175,11 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "re-seed x_camr's rotation when it is farther from the fit's than this Mahalanobis "
            "distance (3 dof)"),
       real("stereo_fit_min_sigma_deg", &C::stereo_fit_min_sigma, kDeg, 0.0, 90.0,
-           "least 1 sigma per axis of the fit's rotation"),
+           "1 sigma added in quadrature per axis to the fit's rotation"),
+      real("stereo_fit_min_sigma_along_lines_deg", &C::stereo_fit_min_sigma_along_lines, kDeg, 0.0,
+           90.0,
+           "1 sigma added about the axis across the baseline and the view (yaw_r of a horizontal "
+           "rig), which one pair barely determines"),
       integer("stereo_fit_attempts", &C::stereo_fit_attempts, 1, 1000,
               "pairs in which the fit is tried after a start before giving up"),
   };

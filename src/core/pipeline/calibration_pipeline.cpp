@@ -215,7 +215,8 @@ bool CalibrationPipeline::seedRightRotationFromFit(std::string* message) {
                                 estimator_->leftCamera(), estimator_->rightCamera(),
                                 T_lopt_ropt.translation().normalized(), fit_config);
   last_seed_ =
-      rightRotationSeed(last_fit_, estimate, covariance, filter_config_.stereo_fit_min_sigma);
+      rightRotationSeed(last_fit_, estimate, covariance, filter_config_.stereo_fit_min_sigma,
+                        filter_config_.stereo_fit_min_sigma_along_lines);
   --stereo_fit_attempts_left_;
   if (!last_seed_.valid) return false;
   stereo_fit_attempts_left_ = 0;  // one valid fit per start

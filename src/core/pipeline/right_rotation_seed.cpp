@@ -29,7 +29,8 @@ Eigen::Matrix3d baselineDirectionCovariance(const StereoExtrinsics& estimate,
 }
 
 RightRotationSeed rightRotationSeed(const GlobalStereoFit& fit, const StereoExtrinsics& estimate,
-                                    const Matrix12d& covariance, double min_sigma) {
+                                    const Matrix12d& covariance, double min_sigma,
+                                    double min_sigma_along_lines) {
   using namespace layout;
   RightRotationSeed seed;
   if (!fit.valid) return seed;
@@ -51,8 +52,19 @@ RightRotationSeed rightRotationSeed(const GlobalStereoFit& fit, const StereoExtr
           : Eigen::Matrix3d(length * length * R_bo * fit.baseline_direction_covariance *
                                 R_bo.transpose() +
                             length_variance * c * c.transpose());
+  // The rotation about the axis across the baseline and the view (optical y for a
+  // horizontal rig) moves the points along their epipolar lines: one pair determines it only
+  // through the perspective's second-order terms, which any model error (a lens residual, an
+  // imperfect rectification) mimics. On KITTI's rectified pairs the fit's is 0.5 deg off
+  // with a formal sigma of 0.01-0.06 deg.
+  const Eigen::Vector3d along_lines =
+      R_bo * fit.baseline_direction.cross(Eigen::Vector3d::UnitZ()).normalized();
   seed.covariance.bottomRightCorner<3, 3>() = R_bo * fit.rotation_covariance * R_bo.transpose() +
                                               min_sigma * min_sigma * Eigen::Matrix3d::Identity();
+  if (along_lines.allFinite()) {
+    seed.covariance.bottomRightCorner<3, 3>() +=
+        min_sigma_along_lines * min_sigma_along_lines * along_lines * along_lines.transpose();
+  }
   seed.covariance.bottomLeftCorner<3, 3>() =
       length * R_bo * fit.rotation_direction_covariance * R_bo.transpose();
   seed.covariance.topRightCorner<3, 3>() = seed.covariance.bottomLeftCorner<3, 3>().transpose();

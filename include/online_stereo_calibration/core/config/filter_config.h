@@ -184,9 +184,14 @@ struct FilterConfig {
   /// Re-seed when x_camr's rotation is farther from the fit's than this Mahalanobis distance
   /// (both covariances, 3 dof).
   double stereo_fit_restart_distance = 3.0;
-  /// rad: the fit's rotation 1 sigma is taken as at least this per axis (its own sigma, from
-  /// the inliers' spread, ignores keypoint biases and a lens model's residual).
+  /// rad: added in quadrature per axis to the fit's rotation 1 sigma (its own, from the
+  /// inliers' spread, ignores keypoint biases and a lens model's residual).
   double stereo_fit_min_sigma = 0.05 * 0.0174532925199432958;
+  /// rad: added in quadrature about the axis across the baseline and the optical axis (yaw_r
+  /// for a horizontal rig), whose rotation slides points along their epipolar lines: one
+  /// pair determines it only through second-order terms that model errors mimic (KITTI:
+  /// 0.5 deg off with a formal 1 sigma of 0.01-0.06 deg).
+  double stereo_fit_min_sigma_along_lines = 1.0 * 0.0174532925199432958;
   /// Pairs in which a fit is tried after a start before giving up (a view without texture
   /// gives none).
   int stereo_fit_attempts = 10;

@@ -20,7 +20,7 @@ struct RightRotationSeed {
   Eigen::Isometry3d T_caml_camr = Eigen::Isometry3d::Identity();
   /// Tangent covariance of T_caml_camr (m, rad): the fit's joint covariance of rotation and
   /// direction (the direction's scaled by the length), the estimate's length variance along
-  /// the direction, and min_sigma^2 added per rotation axis.
+  /// the direction, and the least sigmas added in quadrature (rightRotationSeed).
   Matrix6d covariance = Matrix6d::Zero();
   /// Mahalanobis distance (3 dof) between the estimate's x_camr rotation and the fit's, with
   /// both rotation covariances.
@@ -37,9 +37,12 @@ Eigen::Matrix3d baselineDirectionCovariance(const StereoExtrinsics& estimate,
 /// The seed from @p fit, fitted at @p estimate's baseline direction with the prior
 /// baselineDirectionCovariance(estimate, covariance) (or held there), and its distance from
 /// @p estimate whose filter tangent covariance is @p covariance. @p min_sigma (rad) is added
-/// in quadrature per rotation axis (FilterConfig::stereo_fit_min_sigma). Not valid if the fit
-/// is not.
+/// in quadrature per rotation axis (FilterConfig::stereo_fit_min_sigma), and
+/// @p min_sigma_along_lines (rad) about the axis across the baseline and the optical axis,
+/// whose rotation slides points along their epipolar lines
+/// (FilterConfig::stereo_fit_min_sigma_along_lines). Not valid if the fit is not.
 RightRotationSeed rightRotationSeed(const GlobalStereoFit& fit, const StereoExtrinsics& estimate,
-                                    const Matrix12d& covariance, double min_sigma);
+                                    const Matrix12d& covariance, double min_sigma,
+                                    double min_sigma_along_lines = 0.0);
 
 }  // namespace osc
