@@ -19,6 +19,11 @@ namespace {
 /// may be a glitch (blur, an occlusion, a bad exposure).
 constexpr int kKnockedPairsBeforeReopening = 2;
 
+/// Pairs in which the stereo fit is tried after a start or a re-opening (0: off).
+int stereoFitAttempts(const FilterConfig& config) {
+  return config.stereo_fit_start ? config.stereo_fit_attempts : 0;
+}
+
 }  // namespace
 
 CalibrationPipeline::CalibrationPipeline(const FilterConfig& filter_config,
@@ -31,9 +36,7 @@ CalibrationPipeline::CalibrationPipeline(const FilterConfig& filter_config,
       front_end_(std::make_unique<StereoFrontEnd>(
           front_end_config, filter_config, estimator_->leftCamera(), estimator_->rightCamera())),
       filter_config_(filter_config) {
-  stereo_fit_attempts_left_ =
-      filter_config_.stereo_fit_start ? filter_config_.stereo_fit_attempts : 0;
-  stereo_fit_after_reopening_ = false;
+  stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
 }
 
 CalibrationPipeline::~CalibrationPipeline() = default;
@@ -113,10 +116,8 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
     result.right_camera_reopened = true;
     // The next pairs' whole-image fit re-seeds the re-opened rotation (its wide sigma is no
     // evidence for the old mean, and the fit linearises the filter near the new one).
-    if (filter_config_.stereo_fit_start) {
-      stereo_fit_attempts_left_ = filter_config_.stereo_fit_attempts;
-      stereo_fit_after_reopening_ = true;
-    }
+    stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
+    stereo_fit_after_reopening_ = true;
     result.status = why +
                     ": x_camr's rotation re-opened (a knocked right camera?), tracking "
                     "restarted";
@@ -257,8 +258,7 @@ void CalibrationPipeline::resetTracking() {
 void CalibrationPipeline::reset(const StereoExtrinsics& guess) {
   estimator_->reset(guess);
   restartFrontEnd();
-  stereo_fit_attempts_left_ =
-      filter_config_.stereo_fit_start ? filter_config_.stereo_fit_attempts : 0;
+  stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
   stereo_fit_after_reopening_ = false;
 }
 
@@ -266,8 +266,7 @@ void CalibrationPipeline::reset(const StereoExtrinsics& guess,
                                 const Matrix12d& tangent_covariance) {
   estimator_->reset(guess, tangent_covariance);
   restartFrontEnd();
-  stereo_fit_attempts_left_ =
-      filter_config_.stereo_fit_start ? filter_config_.stereo_fit_attempts : 0;
+  stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
   stereo_fit_after_reopening_ = false;
 }
 
