@@ -10,6 +10,7 @@
 
 #include "online_stereo_calibration/core/frontend/global_stereo_fit.h"
 #include "online_stereo_calibration/core/frontend/stereo_front_end.h"
+#include "online_stereo_calibration/core/pipeline/right_rotation_seed.h"
 #include "online_stereo_calibration/core/sim/measurement_simulator.h"
 #include "online_stereo_calibration/core/sim/stereo_scene_renderer.h"
 
@@ -190,6 +191,37 @@ BENCHMARK(BM_WholeImageStereoFit)
     ->Arg(1280)
     ->ArgName("width")
     ->Unit(benchmark::kMillisecond);
+
+/// The stereo fit at start (FilterConfig::stereo_fit_start): the same fit with the rotation
+/// and the baseline direction refined together under the start's direction prior
+/// (baselineDirectionCovariance of the default 10 cm translation sigma), as
+/// CalibrationPipeline runs it once per start.
+void BM_StartStereoFit(benchmark::State& state) {
+  const Drive& d = drive(static_cast<int>(state.range(0)));
+  Replay replay(d, FrontEndConfig());
+  double inliers = 0.0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const size_t i = replay.next();
+    const auto observations = replay.frontEnd().observe(d.left[i], d.right[i], d.motion[i],
+                                                        replay.estimator().filter(), nullptr);
+    const StereoExtrinsics estimate = replay.estimator().filter().extrinsics();
+    GlobalStereoFitConfig config;
+    config.baseline_direction_covariance =
+        baselineDirectionCovariance(estimate, replay.estimator().filter().covariance());
+    state.ResumeTiming();
+    const GlobalStereoFit fit = fitStereoGeometry(
+        replay.frontEnd().lastLeftFeatures(), replay.frontEnd().lastRightFeatures(),
+        replay.estimator().leftCamera(), replay.estimator().rightCamera(),
+        estimate.leftToRightOptical().translation().normalized(), config);
+    state.PauseTiming();
+    inliers += fit.inliers;
+    replay.finish(replay.estimator().processFrame(d.motion[i], observations));
+    state.ResumeTiming();
+  }
+  state.counters["inliers"] = inliers / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_StartStereoFit)->Arg(640)->ArgName("width")->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace osc

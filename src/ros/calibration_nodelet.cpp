@@ -440,6 +440,10 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
         warning.rfind("mounting rotation from motion", 0) == 0) {
       diagnostics_->recordProblem("mounting rotation from motion", warning);
     }
+    if (result.estimator.right_rotation_from_stereo_fit &&
+        warning.rfind("right camera rotation from the stereo fit", 0) == 0) {
+      diagnostics_->recordProblem("right camera rotation from stereo fit", warning);
+    }
   }
   for (const std::string& warning : result.estimator.warnings) {
     NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: %s", warning.c_str());

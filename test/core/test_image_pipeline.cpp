@@ -170,8 +170,8 @@ TEST(ImagePipelineDiag, DISABLED_StepOfTheRightCamera) {
   const int frames = std::getenv("DIAG_FRAMES") ? std::atoi(std::getenv("DIAG_FRAMES")) : 160;
   rightCameraStep(param, step, frames, [&](const ImageFrameResult& r, const CalibrationPipeline&) {
     if (r.filter.frame < 95) return;
-    std::printf("  frame %d points %d jump %d error %.4f sigma %.4f\n", r.filter.frame,
-                r.filter.tracked_points, r.filter.jump_detected,
+    std::printf("  frame %d points %d jump %d re-seeded %d error %.4f sigma %.4f\n", r.filter.frame,
+                r.filter.tracked_points, r.filter.jump_detected, r.right_rotation_from_stereo_fit,
                 (r.filter.parameters(param) - r.filter.truth(param)) / unit,
                 r.filter.sigmas(param) / unit);
   });

@@ -122,13 +122,19 @@ TEST(Kitti, DISABLED_Diagnostic) {
     if (std::getenv("D_TRANS_NOISE"))
       config.motion_translation_noise = std::atof(std::getenv("D_TRANS_NOISE"));
     if (std::getenv("D_PIXEL_NOISE")) config.pixel_noise = std::atof(std::getenv("D_PIXEL_NOISE"));
+    // D_FIT_DISTANCE: stereo_fit_restart_distance (0: x_camr always re-seeded from the
+    // whole-image fit at start); D_FIT 0: the fit at start off.
+    if (std::getenv("D_FIT_DISTANCE"))
+      config.stereo_fit_restart_distance = std::atof(std::getenv("D_FIT_DISTANCE"));
+    if (std::getenv("D_FIT")) config.stereo_fit_start = std::atoi(std::getenv("D_FIT"));
     const KittiRun run = runKitti(sequence, start, config);
     for (size_t k = 0; k < run.errors.size(); k += 5) {
       const Vector12d& e = run.errors[k];
       const Vector12d& s = run.sigmas[k];
       std::printf(
           "%s %2zu pts %3d | xl %+.3f(%.3f) yl %+.3f(%.3f) zl %+.3f(%.3f) yaw_l %+.3f(%.3f) | yr "
-          "%+.4f(%.4f) roll_r %+.3f(%.3f) pitch_r %+.3f(%.3f) yaw_r %+.3f(%.3f) | dt %+.1f(%.1f) ms\n",
+          "%+.4f(%.4f) roll_r %+.3f(%.3f) pitch_r %+.3f(%.3f) yaw_r %+.3f(%.3f) | dt %+.1f(%.1f) "
+          "ms\n",
           seq, k, run.points[k], e(0), s(0), e(1), s(1), e(2), s(2), e(5) / kDeg, s(5) / kDeg, e(7),
           s(7), e(9) / kDeg, s(9) / kDeg, e(10) / kDeg, s(10) / kDeg, e(11) / kDeg, s(11) / kDeg,
           run.time_offsets[k] * 1e3, run.time_offset_sigmas[k] * 1e3);

@@ -169,6 +169,21 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            100.0,
            "least translation 1 sigma x_caml is restarted with after such a restart (the "
            "camera is likely elsewhere too)"),
+      // --- x_camr's rotation from a whole-image stereo fit at start (issue 14) ---
+      integer("stereo_fit_start", &C::stereo_fit_start, 0, 1,
+              "1: at a start or re-opening of x_camr, fit its rotation over the whole images "
+              "(image level) and re-seed it from the fit if the estimate disagrees; 0: off"),
+      real("stereo_fit_restart_distance", &C::stereo_fit_restart_distance, 1.0, 0.0, 1e6,
+           "re-seed x_camr's rotation when it is farther from the fit's than this Mahalanobis "
+           "distance (3 dof)"),
+      real("stereo_fit_min_sigma_deg", &C::stereo_fit_min_sigma, kDeg, 0.0, 90.0,
+           "1 sigma added in quadrature per axis to the fit's rotation"),
+      real("stereo_fit_min_sigma_along_lines_deg", &C::stereo_fit_min_sigma_along_lines, kDeg, 0.0,
+           90.0,
+           "1 sigma added about the axis across the baseline and the view (yaw_r of a horizontal "
+           "rig), which one pair barely determines"),
+      integer("stereo_fit_attempts", &C::stereo_fit_attempts, 1, 1000,
+              "pairs in which the fit is tried after a start before giving up"),
   };
   return table;
 }

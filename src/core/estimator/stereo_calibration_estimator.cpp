@@ -321,6 +321,40 @@ std::vector<PointId> StereoCalibrationEstimator::reopenRightCameraRotation(doubl
   return dropped;
 }
 
+namespace {
+
+/// @p covariance with x_camr's block replaced by @p block and its correlations with x_caml
+/// dropped.
+Matrix12d withRightCamera(Matrix12d covariance, const Matrix6d& block) {
+  using namespace layout;
+  covariance.middleRows<kPoseDim>(kCamr).setZero();
+  covariance.middleCols<kPoseDim>(kCamr).setZero();
+  covariance.block<kPoseDim, kPoseDim>(kCamr, kCamr) = block;
+  return covariance;
+}
+
+}  // namespace
+
+std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
+    const Eigen::Isometry3d& T_caml_camr, const Matrix6d& covariance, bool start) {
+  std::vector<PointId> dropped;
+  for (const PointEstimate& p : filter_.points()) dropped.push_back(p.id);
+  StereoExtrinsics seeded = filter_.extrinsics();
+  seeded.T_caml_camr = T_caml_camr;
+  filter_.reset(seeded, withRightCamera(filter_.covariance(), covariance));
+  guess_.T_caml_camr = T_caml_camr;
+  guess_covariance_ = withRightCamera(Matrix12d(guess_covariance_), covariance);
+  has_previous_frame_ = false;
+  mounting_.forgetFrame();
+  if (start) {
+    anchorHere(JumpBlock::kNone, 0.0, 0.0);
+  } else {
+    anchorHere(JumpBlock::kLeftToRight, std::sqrt(covariance.diagonal().head<3>().maxCoeff()),
+               std::sqrt(covariance.diagonal().tail<3>().maxCoeff()));
+  }
+  return dropped;
+}
+
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
   guess_ = guess;
   mounting_.clear();

@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
@@ -110,6 +111,74 @@ RotationRefinement refineRotation(const Eigen::Matrix3d& R_start, const Eigen::V
   return out;
 }
 
+struct JointRefinement {
+  bool ok = false;
+  Eigen::Matrix3d R_lopt_ropt;
+  Eigen::Vector3d c;
+  Eigen::Matrix<double, 5, 5> covariance;  ///< [rotation e (3), direction d (2) in basis B]
+  Eigen::Matrix<double, 3, 2> B;           ///< basis of the plane perpendicular to the prior c
+};
+
+/// Gauss-Newton over R_lopt_ropt = R * Exp(e) and c = normalised(c0 + B d) on the Sampson
+/// distances divided by their spread @p s (normalised units) and the prior residual on d
+/// (whitened by the prior's covariance in the plane perpendicular to c0).
+JointRefinement refineRotationAndDirection(const Eigen::Matrix3d& R_start,
+                                           const Eigen::Vector3d& c0,
+                                           const Eigen::Matrix3d& direction_covariance, double s,
+                                           const std::vector<Eigen::Vector3d>& left,
+                                           const std::vector<Eigen::Vector3d>& right) {
+  JointRefinement out;
+  const int n = static_cast<int>(left.size());
+  if (n < 6 || !(s > 0.0)) return out;
+  // A basis of the plane perpendicular to c0.
+  const Eigen::Vector3d helper =
+      std::abs(c0.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  out.B.col(0) = c0.cross(helper).normalized();
+  out.B.col(1) = c0.cross(out.B.col(0)).normalized();
+  const Eigen::Matrix2d prior = out.B.transpose() * direction_covariance * out.B;
+  const Eigen::LLT<Eigen::Matrix2d> prior_llt(0.5 * (prior + prior.transpose()));
+  if (prior_llt.info() != Eigen::Success) return out;
+  const Eigen::Matrix2d W = prior_llt.matrixL().solve(Eigen::Matrix2d::Identity());
+  const auto residuals = [&](const Eigen::Matrix3d& R_lopt_ropt, const Eigen::Vector2d& d) {
+    const Eigen::Vector3d c = (c0 + out.B * d).normalized();
+    Eigen::Matrix3d c_cross;
+    c_cross << 0, -c.z(), c.y(), c.z(), 0, -c.x(), -c.y(), c.x(), 0;
+    const Eigen::Matrix3d E = R_lopt_ropt.transpose() * c_cross;
+    Eigen::VectorXd r(n + 2);
+    for (int i = 0; i < n; ++i)
+      r(i) = sampson(E, left[static_cast<size_t>(i)], right[static_cast<size_t>(i)]) / s;
+    r.tail<2>() = W * d;
+    return r;
+  };
+  constexpr double kStep = 1e-7;  // numeric derivative
+  Eigen::Matrix3d R = R_start;
+  Eigen::Vector2d d = Eigen::Vector2d::Zero();
+  Eigen::Matrix<double, 5, 5> JtJ = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::VectorXd r = residuals(R, d);
+  for (int iteration = 0; iteration < 12; ++iteration) {
+    Eigen::MatrixXd J(n + 2, 5);
+    for (int k = 0; k < 5; ++k) {
+      const Eigen::VectorXd moved = k < 3
+                                        ? residuals(R * expSO3(kStep * Eigen::Vector3d::Unit(k)), d)
+                                        : residuals(R, d + kStep * Eigen::Vector2d::Unit(k - 3));
+      J.col(k) = (moved - r) / kStep;
+    }
+    JtJ = J.transpose() * J;
+    const Eigen::Matrix<double, 5, 1> step = JtJ.ldlt().solve(-J.transpose() * r);
+    if (!step.allFinite()) return out;
+    R = R * expSO3(step.head<3>());
+    d += step.tail<2>();
+    r = residuals(R, d);
+    if (step.norm() < 1e-10) break;
+  }
+  out.R_lopt_ropt = R;
+  out.c = (c0 + out.B * d).normalized();
+  out.covariance = JtJ.inverse();
+  out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
+  out.ok = out.covariance.allFinite() && out.covariance.diagonal().minCoeff() > 0.0;
+  return out;
+}
+
 }  // namespace
 
 double rotationAngleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
@@ -181,6 +250,26 @@ GlobalStereoFit fitStereoGeometry(const FeatureSet& left, const FeatureSet& righ
   fit.rotation_covariance = refined.covariance;
   fit.rms_px = refined.rms * focal;
   fit.valid = refined.rotation_covariance_ok;
+  fit.baseline_direction = baseline_direction.normalized();
+  if (fit.valid && !config.baseline_direction_covariance.isZero()) {
+    // The inliers' own spread about their lines (held fit, 3 dof) weighs them against the
+    // direction's prior.
+    const int n = static_cast<int>(rays_left.size());
+    const double s = refined.rms * std::sqrt(static_cast<double>(n) / std::max(1, n - 3));
+    const JointRefinement joint =
+        refineRotationAndDirection(refined.R_lopt_ropt, fit.baseline_direction,
+                                   config.baseline_direction_covariance, s, rays_left, rays_right);
+    fit.valid = joint.ok;
+    if (joint.ok) {
+      fit.R_lopt_ropt = joint.R_lopt_ropt;
+      fit.baseline_direction = joint.c;
+      fit.rotation_covariance = joint.covariance.topLeftCorner<3, 3>();
+      fit.rotation_direction_covariance =
+          joint.covariance.topRightCorner<3, 2>() * joint.B.transpose();
+      fit.baseline_direction_covariance =
+          joint.B * joint.covariance.bottomRightCorner<2, 2>() * joint.B.transpose();
+    }
+  }
   fit.why = std::to_string(fit.inliers) + " inliers of " + std::to_string(fit.matches) +
             " matches, " + std::to_string(fit.rms_px) + " px RMS" +
             (fit.valid ? "" : ", rotation not determined");

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "online_stereo_calibration/core/filter/state_layout.h"
@@ -18,6 +19,11 @@ namespace {
 /// may be a glitch (blur, an occlusion, a bad exposure).
 constexpr int kKnockedPairsBeforeReopening = 2;
 
+/// Pairs in which the stereo fit is tried after a start or a re-opening (0: off).
+int stereoFitAttempts(const FilterConfig& config) {
+  return config.stereo_fit_start ? config.stereo_fit_attempts : 0;
+}
+
 }  // namespace
 
 CalibrationPipeline::CalibrationPipeline(const FilterConfig& filter_config,
@@ -28,7 +34,10 @@ CalibrationPipeline::CalibrationPipeline(const FilterConfig& filter_config,
     : estimator_(
           std::make_unique<StereoCalibrationEstimator>(filter_config, left, right, initial_guess)),
       front_end_(std::make_unique<StereoFrontEnd>(
-          front_end_config, filter_config, estimator_->leftCamera(), estimator_->rightCamera())) {}
+          front_end_config, filter_config, estimator_->leftCamera(), estimator_->rightCamera())),
+      filter_config_(filter_config) {
+  stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
+}
 
 CalibrationPipeline::~CalibrationPipeline() = default;
 
@@ -59,15 +68,31 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   }
   result.stereo_pairs = front_end_->observe(left_mono, right_mono, motion_since_last_processed,
                                             estimator_->filter(), &result.front_end);
+  std::string seeded;
+  if (stereo_fit_attempts_left_ > 0) {
+    result.stereo_fit_tried = true;
+    if (seedRightRotationFromFit(&seeded)) {
+      // The pairs were matched in the epipolar band of the old rotation: again in the fit's.
+      front_end_->reset();
+      result.stereo_pairs = front_end_->observe(left_mono, right_mono, motion_since_last_processed,
+                                                estimator_->filter(), &result.front_end);
+    }
+    result.stereo_fit = last_seed_;
+  }
   result.estimator = estimator_->processFrame(motion_since_last_processed, result.stereo_pairs);
   front_end_->commit(result.estimator, estimator_->filter());
   feedHandEye(motion_since_last_processed);
+  if (!seeded.empty()) {
+    result.estimator.right_rotation_from_stereo_fit = true;
+    result.estimator.warnings.insert(result.estimator.warnings.begin(), seeded);
+  }
   result.processed = true;
   result.status = result.estimator.motion_rejected ? "processed (motion rejected, tracks reset)"
                   : result.estimator.relinearized
                       ? "processed (restarted from the current estimate: re-linearised, tracks "
                         "reset)"
-                      : "ok";
+                  : !seeded.empty() ? "processed (" + seeded + ")"
+                                    : "ok";
   // A knocked right camera. Beyond the epipolar band of a converged x_camr no pair reaches
   // the filter, so its own jump test never sees one; within it the pairs reach it but, off
   // their lines by tens of its sigmas, are followed only through x_camr's slow drift noise.
@@ -89,6 +114,10 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
     estimator_->reopenRightCameraRotation(rotation_sigma);
     restartFrontEnd();
     result.right_camera_reopened = true;
+    // The next pairs' whole-image fit re-seeds the re-opened rotation (its wide sigma is no
+    // evidence for the old mean, and the fit linearises the filter near the new one).
+    stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
+    stereo_fit_after_reopening_ = true;
     result.status = why +
                     ": x_camr's rotation re-opened (a knocked right camera?), tracking "
                     "restarted";
@@ -177,6 +206,45 @@ bool CalibrationPipeline::wholeImageFitContradicts(double* rotation_sigma, std::
   return fits_contradicting_ >= kKnockedPairsBeforeReopening;
 }
 
+bool CalibrationPipeline::seedRightRotationFromFit(std::string* message) {
+  const StereoExtrinsics estimate = estimator_->filter().extrinsics();
+  const Eigen::Isometry3d T_lopt_ropt = estimate.leftToRightOptical();
+  const Matrix12d covariance = estimator_->filter().covariance();
+  GlobalStereoFitConfig fit_config;
+  fit_config.baseline_direction_covariance = baselineDirectionCovariance(estimate, covariance);
+  last_fit_ = fitStereoGeometry(front_end_->lastLeftFeatures(), front_end_->lastRightFeatures(),
+                                estimator_->leftCamera(), estimator_->rightCamera(),
+                                T_lopt_ropt.translation().normalized(), fit_config);
+  last_seed_ =
+      rightRotationSeed(last_fit_, estimate, covariance, filter_config_.stereo_fit_min_sigma,
+                        filter_config_.stereo_fit_min_sigma_along_lines);
+  --stereo_fit_attempts_left_;
+  if (!last_seed_.valid) return false;
+  stereo_fit_attempts_left_ = 0;  // one valid fit per start
+  const bool after_reopening = stereo_fit_after_reopening_;
+  stereo_fit_after_reopening_ = false;
+  if (!after_reopening && !(last_seed_.distance > filter_config_.stereo_fit_restart_distance)) {
+    return false;
+  }
+  const Eigen::Vector3d before = rpyFromRotation(estimate.T_caml_camr.linear()) * 180.0 / M_PI;
+  const Eigen::Vector3d after = rpyFromRotation(last_seed_.T_caml_camr.linear()) * 180.0 / M_PI;
+  const Eigen::Vector3d sigma =
+      last_seed_.covariance.diagonal().tail<3>().cwiseSqrt() * 180.0 / M_PI;
+  estimator_->reseedRightCamera(last_seed_.T_caml_camr, last_seed_.covariance, !after_reopening);
+  std::ostringstream text;
+  text.precision(3);
+  text << "right camera rotation from the stereo fit: x_camr's roll/pitch/yaw re-seeded "
+       << (after_reopening ? "after its re-opening " : "") << "at " << after(0) << "/" << after(1)
+       << "/" << after(2) << " deg (1 sigma " << sigma(0) << "/" << sigma(1) << "/" << sigma(2)
+       << " deg; was " << before(0) << "/" << before(1) << "/" << before(2) << " deg, "
+       << last_seed_.distance << " sigmas and " << last_seed_.angle * 180.0 / M_PI
+       << " deg apart; whole-image fit " << last_fit_.why
+       << "); baseline direction refined with the guess's as prior, its length kept; tracks "
+          "reset";
+  *message = text.str();
+  return true;
+}
+
 void CalibrationPipeline::restartFrontEnd() {
   front_end_->reset();
   pairs_without_stereo_ = pairs_off_their_lines_ = fits_contradicting_ = 0;
@@ -190,12 +258,16 @@ void CalibrationPipeline::resetTracking() {
 void CalibrationPipeline::reset(const StereoExtrinsics& guess) {
   estimator_->reset(guess);
   restartFrontEnd();
+  stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
+  stereo_fit_after_reopening_ = false;
 }
 
 void CalibrationPipeline::reset(const StereoExtrinsics& guess,
                                 const Matrix12d& tangent_covariance) {
   estimator_->reset(guess, tangent_covariance);
   restartFrontEnd();
+  stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
+  stereo_fit_after_reopening_ = false;
 }
 
 CalibrationEstimate CalibrationPipeline::estimate() const { return estimator_->estimate(); }

@@ -149,6 +149,8 @@ std::vector<ImageFrameResult> runImageScenario(
     const PipelineResult result = pipeline.process(left, right, motion);
     r.processed = result.processed;
     r.front_end = result.front_end;
+    if (result.stereo_fit_tried) r.stereo_fit = result.stereo_fit;
+    r.right_rotation_from_stereo_fit = result.estimator.right_rotation_from_stereo_fit;
     since_processed.reset();
     if (!result.processed) {
       // Nothing to check: the front end's lists are still the last processed pair's.

@@ -264,6 +264,15 @@ int evaluateBag(const Options& options) {
     }
     previous_stamp = stamp;
     have_previous = true;
+    // What the estimator did at a start far off (issue 14), in the progress output.
+    for (const std::string& warning : result.estimator.warnings) {
+      if ((result.estimator.right_rotation_from_stereo_fit &&
+           warning.rfind("right camera rotation from the stereo fit", 0) == 0) ||
+          (result.estimator.mounting_rotation_from_motion &&
+           warning.rfind("mounting rotation from motion", 0) == 0)) {
+        std::cerr << "\nevaluate: pair " << frame << ": " << warning << "\n";
+      }
+    }
     osc::EstimateRow row;
     row.frame = frame;
     row.stamp = stamp;

@@ -181,6 +181,27 @@ struct FilterConfig {
   /// m: least translation 1 sigma x_caml is restarted with (a camera whose rotation was
   /// guessed that far off is likely elsewhere too: at the tailgate, under a mirror).
   double hand_eye_restart_translation_sigma = 1.5;
+
+  // --- x_camr's rotation from a whole-image stereo fit at start (issue 14; image level) ---
+  /// 1: when the filter starts (first pairs, a reset, a re-opening of x_camr's rotation), the
+  /// image pipeline fits x_camr's rotation over the whole images without the calibration
+  /// (global_stereo_fit.h) and, if the estimate disagrees with it, re-seeds x_camr's rotation
+  /// from it with the fit's covariance; 0: off (the paper).
+  int stereo_fit_start = 1;
+  /// Re-seed when x_camr's rotation is farther from the fit's than this Mahalanobis distance
+  /// (both covariances, 3 dof).
+  double stereo_fit_restart_distance = 3.0;
+  /// rad: added in quadrature per axis to the fit's rotation 1 sigma (its own, from the
+  /// inliers' spread, ignores keypoint biases and a lens model's residual).
+  double stereo_fit_min_sigma = 0.05 * 0.0174532925199432958;
+  /// rad: added in quadrature about the axis across the baseline and the optical axis (yaw_r
+  /// for a horizontal rig), whose rotation slides points along their epipolar lines: one
+  /// pair determines it only through second-order terms that model errors mimic (KITTI:
+  /// 0.5 deg off with a formal 1 sigma of 0.01-0.06 deg).
+  double stereo_fit_min_sigma_along_lines = 1.0 * 0.0174532925199432958;
+  /// Pairs in which a fit is tried after a start before giving up (a view without texture
+  /// gives none).
+  int stereo_fit_attempts = 10;
 };
 
 /// One row of the parameter table.

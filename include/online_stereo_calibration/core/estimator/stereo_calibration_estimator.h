@@ -64,6 +64,10 @@ struct FrameReport {
   /// camera's motion (FilterConfig::hand_eye_start; the warning names the old and new
   /// roll/pitch/yaw); tracks reset.
   bool mounting_rotation_from_motion = false;
+  /// x_camr's rotation was re-seeded from a whole-image stereo fit at a start or after a
+  /// re-opening (CalibrationPipeline, FilterConfig::stereo_fit_start; the warning names the
+  /// old and new angles and the distance); tracks reset.
+  bool right_rotation_from_stereo_fit = false;
   std::vector<std::string> warnings;  ///< human-readable, one per problem
 };
 
@@ -85,6 +89,15 @@ class StereoCalibrationEstimator {
   /// re-opened to at least `rotation_sigma` (rad; its translation kept: a knock turns a
   /// camera) and every point is forgotten. Returns the forgotten points.
   std::vector<PointId> reopenRightCameraRotation(double rotation_sigma);
+  /// x_camr re-seeded from a whole-image stereo fit (CalibrationPipeline at a start or after
+  /// a re-opening, FilterConfig::stereo_fit_start): its mean becomes @p T_caml_camr and its tangent
+  /// covariance block @p covariance (m, rad; [dt, dtheta] as the filter's), uncorrelated with
+  /// x_caml, which keeps its estimate and covariance. The start's guess takes the same x_camr
+  /// (a later hand-eye restart keeps it). Every point is forgotten and the odometry states
+  /// (the time offset) start from their priors. Re-linearised (relinearizeIfMoved) as after
+  /// a start if @p start, else as after a re-opening of x_camr. Returns the forgotten points.
+  std::vector<PointId> reseedRightCamera(const Eigen::Isometry3d& T_caml_camr,
+                                         const Matrix6d& covariance, bool start);
   /// Starts over from a new guess with the config's initial uncertainty.
   void reset(const StereoExtrinsics& guess);
   /// Starts over from a saved calibration with its covariance (tangent, see filter) as

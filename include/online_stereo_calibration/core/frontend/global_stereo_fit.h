@@ -33,6 +33,15 @@ struct GlobalStereoFit {
   Eigen::Vector3d free_baseline_direction = Eigen::Vector3d::UnitX();
   /// RMS distance (px) of the inliers from their epipolar lines under R_lopt_ropt.
   double rms_px = 0.0;
+  /// The baseline direction (unit, left optical frame) R_lopt_ropt goes with: the caller's
+  /// if held (GlobalStereoFitConfig::baseline_direction_covariance zero), else the one
+  /// refined together with the rotation under that prior.
+  Eigen::Vector3d baseline_direction = Eigen::Vector3d::UnitX();
+  /// With a direction prior only (else zero): covariance of baseline_direction's change
+  /// (perpendicular to it, rank 2) and its cross-covariance with the rotation error (rows
+  /// rotation, as rotation_covariance, which is then the rotation's marginal covariance).
+  Eigen::Matrix3d baseline_direction_covariance = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d rotation_direction_covariance = Eigen::Matrix3d::Zero();
 };
 
 /// Matching and RANSAC settings of fitStereoGeometry.
@@ -41,6 +50,12 @@ struct GlobalStereoFitConfig {
   double ratio = 0.8;                     ///< Lowe's ratio: best < ratio * second best
   double ransac_threshold = 1.0;          ///< px, distance from the epipolar line
   int min_inliers = 30;                   ///< fewer: not valid
+  /// Prior covariance (left optical frame; its part perpendicular to the direction is used)
+  /// of the change of the baseline direction given to fitStereoGeometry. Zero (default): the
+  /// direction is held there. Otherwise the rotation and the direction are refined together
+  /// (maximum a posteriori: the inliers' Sampson distances, weighted by their own spread, and
+  /// this prior), since one pair determines the rotation well only with the direction.
+  Eigen::Matrix3d baseline_direction_covariance = Eigen::Matrix3d::Zero();
 };
 
 /// Fits the pair's epipolar geometry from its keypoints (as StereoFrontEnd detected them):
@@ -48,7 +63,9 @@ struct GlobalStereoFitConfig {
 /// their Sampson distances) with the baseline direction held at @p baseline_direction (unit,
 /// left optical frame, e.g. the current estimate's). One pair cannot separate a rotation
 /// from a turn of the baseline direction well (on EuRoC the free five-point solution is
-/// 0.5-1 deg and 11-27 deg off), while a knock turns the camera, not its centre.
+/// 0.5-1 deg and 11-27 deg off), while a knock turns the camera, not its centre. With a prior
+/// on the direction (GlobalStereoFitConfig::baseline_direction_covariance) both are refined
+/// together instead, with their joint covariance.
 /// Costs about one Hamming distance per left x right keypoint pair: call it only when
 /// needed. Never throws for degenerate input; the result is then not valid.
 GlobalStereoFit fitStereoGeometry(const FeatureSet& left, const FeatureSet& right,

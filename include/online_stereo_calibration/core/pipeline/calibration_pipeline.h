@@ -15,6 +15,7 @@
 #include "online_stereo_calibration/core/frontend/feature_detection.h"
 #include "online_stereo_calibration/core/frontend/front_end_config.h"
 #include "online_stereo_calibration/core/frontend/global_stereo_fit.h"
+#include "online_stereo_calibration/core/pipeline/right_rotation_seed.h"
 
 namespace osc {
 
@@ -47,6 +48,11 @@ struct PipelineResult {
   /// refined pairs of both off their epipolar lines by far more than x_camr's sigma allows.
   /// x_camr's rotation was re-opened and tracking restarted.
   bool right_camera_reopened = false;
+  /// The whole-image stereo fit at a start was tried in this pair
+  /// (FilterConfig::stereo_fit_start); stereo_fit is its seed (valid if the fit was), and
+  /// estimator.right_rotation_from_stereo_fit says whether x_camr's rotation was re-seeded.
+  bool stereo_fit_tried = false;
+  RightRotationSeed stereo_fit;
   double processing_time = 0.0;  ///< seconds spent on this pair (front end + filter)
 };
 
@@ -94,6 +100,12 @@ class CalibrationPipeline {
   /// Forgets the front end's tracks and the counts below (the estimator's points are the
   /// caller's to drop).
   void restartFrontEnd();
+  /// The stereo fit at a start or after a re-opening of x_camr's rotation
+  /// (FilterConfig::stereo_fit_start): fits the last pair over the whole images and, if
+  /// x_camr's rotation is farther from the fit's than stereo_fit_restart_distance (after a
+  /// re-opening: always), re-seeds x_camr from the fit (rightRotationSeed). True if it did;
+  /// @p message then says what changed. A valid fit ends the attempts.
+  bool seedRightRotationFromFit(std::string* message);
   /// Counts pairs in which no stereo pair was found although both images had features; true
   /// (a knocked right camera) from the second in a row.
   bool lostTheStereoGeometry(const FrontEndStatistics& stats);
@@ -117,6 +129,13 @@ class CalibrationPipeline {
   /// Consecutive whole-image fits contradicting x_camr (wholeImageFitContradicts).
   int fits_contradicting_ = 0;
   GlobalStereoFit last_fit_;
+  RightRotationSeed last_seed_;
+  /// Pairs left in which the stereo fit at a start is tried (0: none pending).
+  int stereo_fit_attempts_left_ = 0;
+  /// The pending fit follows a re-opening of x_camr's rotation: its first valid fit re-seeds
+  /// whatever the distance.
+  bool stereo_fit_after_reopening_ = false;
+  FilterConfig filter_config_;
   /// The previous processed pair's left keypoints, kept while the estimator's hand-eye start
   /// collects (feedHandEye).
   FeatureSet previous_left_features_;

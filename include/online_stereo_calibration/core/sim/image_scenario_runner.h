@@ -62,6 +62,10 @@ struct ImageFrameResult {
   /// ... still on the surface point seen exactly at their birth's left pixel
   int tracks_correct_at_birth_pixel = 0;
   double render_ms = 0.0;  ///< time spent rendering this pair
+  /// The whole-image stereo fit at a start, if tried in this pair
+  /// (PipelineResult::stereo_fit), and whether x_camr's rotation was re-seeded from it.
+  std::optional<RightRotationSeed> stereo_fit;
+  bool right_rotation_from_stereo_fit = false;
 };
 
 /// What the scene says about a stereo pair (left_pixel, right_pixel).

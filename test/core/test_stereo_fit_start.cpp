@@ -1,0 +1,219 @@
+/// @file test_stereo_fit_start.cpp
+/// @brief The global stereo fit at start (issue 14): x_camr's rotation from a whole-image fit
+/// in the filter's frames (rightRotationSeed), and at image level (rendered drive, the
+/// CalibrationPipeline) a start with x_camr's angles 5 deg off re-seeded from it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "online_stereo_calibration/core/filter/state_layout.h"
+#include "online_stereo_calibration/core/geometry/rotation.h"
+#include "online_stereo_calibration/core/pipeline/right_rotation_seed.h"
+#include "online_stereo_calibration/core/sim/image_scenario_runner.h"
+
+namespace osc {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+StereoExtrinsics rig(double roll_r, double pitch_r, double yaw_r) {
+  Vector12d p;
+  p << 1.5, 0.15, 1.3, 0.0, 0.05, 0.0, 0.0, -0.30, 0.0, roll_r, pitch_r, yaw_r;
+  return StereoExtrinsics::fromParameters(p);
+}
+
+// The fit's rotation (left -> right optical) comes back as x_camr's body rotation, and the
+// distance is the difference's in the combined sigmas. A fit that held the baseline direction
+// keeps the estimate's translation and its covariance.
+TEST(RightRotationSeed, ConvertsTheOpticalFitToTheBodyRotationAndMeasuresTheDistance) {
+  const StereoExtrinsics truth = rig(1.0 * kDeg, -2.0 * kDeg, 0.5 * kDeg);
+  GlobalStereoFit fit;
+  fit.valid = true;
+  fit.R_lopt_ropt = truth.leftToRightOptical().linear();
+  fit.baseline_direction = truth.leftToRightOptical().translation().normalized();
+  fit.rotation_covariance = Eigen::Matrix3d::Identity() * std::pow(0.1 * kDeg, 2);
+  StereoExtrinsics guess = truth;
+  guess.T_caml_camr.linear() = truth.T_caml_camr.linear() * expSO3(Eigen::Vector3d(0, 0, 1) * kDeg);
+  Matrix12d P = Matrix12d::Identity() * 1e-4;
+  P.block<3, 3>(9, 9) = Eigen::Matrix3d::Identity() * std::pow(0.3 * kDeg, 2);
+  const RightRotationSeed seed = rightRotationSeed(fit, guess, P, 0.0);
+  ASSERT_TRUE(seed.valid);
+  EXPECT_LT(rotationAngleBetween(seed.T_caml_camr.linear(), truth.T_caml_camr.linear()), 1e-12);
+  EXPECT_LT((seed.T_caml_camr.translation() - truth.T_caml_camr.translation()).norm(), 1e-12);
+  EXPECT_NEAR(seed.angle, 1.0 * kDeg, 1e-9);
+  // 1 deg apart, sigmas 0.1 and 0.3 deg: 1 / sqrt(0.01 + 0.09) = 3.16 sigmas.
+  EXPECT_NEAR(seed.distance, 1.0 / std::sqrt(0.01 + 0.09), 1e-6);
+  const Eigen::Matrix3d translation = seed.covariance.topLeftCorner<3, 3>();
+  EXPECT_TRUE(translation.isApprox(P.block<3, 3>(6, 6)));
+  // The least sigma is added in quadrature.
+  const RightRotationSeed floored = rightRotationSeed(fit, guess, P, 0.2 * kDeg);
+  EXPECT_NEAR(floored.covariance(3, 3), std::pow(0.1 * kDeg, 2) + std::pow(0.2 * kDeg, 2), 1e-15);
+  // ... and about the axis across the baseline and the view (optical y, body z: yaw_r) the
+  // along-lines sigma.
+  const RightRotationSeed along = rightRotationSeed(fit, guess, P, 0.0, 1.0 * kDeg);
+  EXPECT_NEAR(along.covariance(5, 5), std::pow(0.1 * kDeg, 2) + std::pow(1.0 * kDeg, 2), 1e-12);
+  EXPECT_NEAR(along.covariance(3, 3), std::pow(0.1 * kDeg, 2), 1e-8);
+  EXPECT_NEAR(along.covariance(4, 4), std::pow(0.1 * kDeg, 2), 1e-8);
+  EXPECT_FALSE(rightRotationSeed(GlobalStereoFit(), guess, P, 0.0).valid);
+}
+
+// A fit that refined the baseline direction: the estimate's length along the fitted
+// direction, the direction's covariance (optical, of the unit vector) scaled by the length,
+// the length's variance along it, and the rotation-direction correlation carried into the
+// body frame. Optical y is body -z, optical x is body -y.
+TEST(RightRotationSeed, CarriesTheFittedBaselineDirectionAndItsCorrelation) {
+  const StereoExtrinsics truth = rig(0.0, 0.0, 0.0);  // right camera at body y = -0.3
+  GlobalStereoFit fit;
+  fit.valid = true;
+  fit.R_lopt_ropt = truth.leftToRightOptical().linear();
+  const double tilt = 0.01;  // rad, the fitted direction tilted towards optical -y (body +z)
+  fit.baseline_direction = Eigen::Vector3d(1.0, -tilt, 0.0).normalized();
+  fit.rotation_covariance = Eigen::Matrix3d::Identity() * 1e-6;
+  fit.baseline_direction_covariance = Eigen::Vector3d(0.0, 1e-4, 1e-4).asDiagonal();
+  fit.rotation_direction_covariance(0, 1) = 0.9e-5;  // optical e_x with c_y
+  Matrix12d P = Matrix12d::Identity() * 1e-4;
+  P(7, 7) = 0.1 * 0.1;  // the length (body y) 0.1 m
+  const RightRotationSeed seed = rightRotationSeed(fit, truth, P, 0.0);
+  ASSERT_TRUE(seed.valid);
+  EXPECT_NEAR(seed.T_caml_camr.translation().norm(), 0.3, 1e-12);
+  EXPECT_NEAR(seed.T_caml_camr.translation().z(), 0.3 * tilt, 1e-5);
+  // body z: 0.3^2 * 1e-4 across, plus the length's 0.01 along the tilted direction; body y:
+  // the length's.
+  const double c2 = 1.0 / (1.0 + tilt * tilt);  // the direction's squared body y component
+  EXPECT_NEAR(seed.covariance(2, 2), 0.09 * 1e-4 + 0.01 * (1.0 - c2), 1e-12);
+  EXPECT_NEAR(seed.covariance(1, 1), 0.01 * c2, 1e-12);
+  // Optical (e_x, c_y) is body (-e_y, -c_z): cov(e_y, t_z) = 0.3 * 0.9e-5.
+  EXPECT_NEAR(seed.covariance(4, 2), 0.3 * 0.9e-5, 1e-12);
+  EXPECT_NEAR(seed.covariance(2, 4), 0.3 * 0.9e-5, 1e-12);
+}
+
+struct StartRun {
+  int reseeded_at = -1, fits = 0, frames = 0, within = 0, beyond = 0;
+  double worst = 0.0;
+  double fit_z = 0.0;  ///< largest |fit error| / fit sigma per body axis
+  double last_rotation_error = 0.0, last_translation_error = 0.0;  ///< x_camr's, rad and m
+};
+
+StartRun runStart(const Vector12d& initial_error, int frames, int stereo_fit_start,
+                  unsigned seed = 1) {
+  MeasurementScenario scenario = paperOffroadScenario();
+  scenario.seed = seed;
+  scenario.frames = frames;
+  scenario.step_frame = -1;
+  scenario.initial_error = initial_error;
+  FilterConfig config;
+  config.stereo_fit_start = stereo_fit_start;
+  StartRun run;
+  runImageScenario(
+      scenario, config, FrontEndConfig(), {},
+      [&](const ImageFrameResult& r, const CalibrationPipeline&) {
+        if (r.stereo_fit && r.stereo_fit->valid) {
+          ++run.fits;
+          const Eigen::Matrix3d R_true =
+              StereoExtrinsics::fromParameters(r.filter.truth).T_caml_camr.linear();
+          const Eigen::Vector3d e = logSO3(R_true.transpose() * r.stereo_fit->T_caml_camr.linear());
+          if (getenv("OSC_STEREO_FIT_TRACE") != nullptr) {
+            std::cout << "frame " << r.filter.frame << ": fit error " << e.transpose() / kDeg
+                      << " deg, sigma "
+                      << r.stereo_fit->covariance.diagonal().tail<3>().cwiseSqrt().transpose() /
+                             kDeg
+                      << " deg, distance " << r.stereo_fit->distance << "\n";
+          }
+          run.fit_z = e.cwiseQuotient(r.stereo_fit->covariance.diagonal().tail<3>().cwiseSqrt())
+                          .cwiseAbs()
+                          .maxCoeff();
+        }
+        if (r.right_rotation_from_stereo_fit && run.reseeded_at < 0) {
+          run.reseeded_at = r.filter.frame;
+        }
+        run.last_rotation_error = r.filter.tangent_error.tail<3>().norm();
+        run.last_translation_error = r.filter.tangent_error.segment<3>(6).norm();
+        if (r.filter.frame < 30) return;
+        const double z =
+            r.filter.tangent_error.cwiseQuotient(r.filter.tangent_sigmas).cwiseAbs().maxCoeff();
+        ++run.frames;
+        run.within += z <= 3.0;
+        run.beyond += z > 5.0;
+        run.worst = std::max(run.worst, z);
+      });
+  return run;
+}
+
+// Issue 14: x_camr's angles 5 deg off (2.5 times the 2 deg start sigma). The whole-image fit
+// of the first pair re-seeds x_camr's rotation, and from frame 30 on all 12 errors are within
+// 3 sigma in >= 95 % of the frames and never beyond 5 sigma. A good guess is left alone.
+TEST(StereoFitStart, RightCameraFiveDegreesOffIsReseededFromTheFirstPair) {
+  Vector12d error = paperOffroadScenario().initial_error;
+  error.tail<3>().setConstant(5.0 * kDeg);
+  const StartRun on = runStart(error, 120, 1);
+  std::cout << "x_camr 5 deg off: re-seeded at frame " << on.reseeded_at << ", fit error "
+            << on.fit_z << " sigma; from frame 30 all 12 within 3 sigma in " << on.within << " of "
+            << on.frames << ", beyond 5 sigma in " << on.beyond << ", worst " << on.worst << "\n";
+  EXPECT_EQ(on.reseeded_at, 0);
+  EXPECT_EQ(on.fits, 1);
+  EXPECT_LT(on.fit_z, 3.0);
+  EXPECT_GE(on.within, 0.95 * on.frames);
+  EXPECT_EQ(on.beyond, 0) << "worst " << on.worst;
+
+  // The seed's own start errors with x_camr's angles exact: the fit agrees, nothing changes.
+  const StartRun good = runStart(paperOffroadScenario().initial_error, 3, 1);
+  EXPECT_EQ(good.fits, 1);
+  EXPECT_EQ(good.reseeded_at, -1);
+}
+
+// The figures of docs/RESULTS.md "Stereo fit at start": image-level starts with x_camr's
+// angles 5 deg off and the baseline 50 % short and long (the seed's other start errors),
+// seeds 1-3, with the fit at start off and on. Run with --gtest_also_run_disabled_tests;
+// OSC_STEREO_FIT_FRAMES (250) and OSC_STEREO_FIT_SEEDS (3) change the drives.
+TEST(StereoFitStart, DISABLED_Report) {
+  const int frames =
+      getenv("OSC_STEREO_FIT_FRAMES") ? std::atoi(getenv("OSC_STEREO_FIT_FRAMES")) : 250;
+  const int seeds = getenv("OSC_STEREO_FIT_SEEDS") ? std::atoi(getenv("OSC_STEREO_FIT_SEEDS")) : 3;
+  struct Case {
+    const char* name;
+    Vector12d error;
+  };
+  std::vector<Case> cases;
+  const Vector12d paper = paperOffroadScenario().initial_error;
+  Vector12d e = paper;
+  e.tail<3>() << 5.0 * kDeg, 5.0 * kDeg, 5.0 * kDeg;
+  cases.push_back({"x_camr angles +5/+5/+5 deg", e});
+  e.tail<3>() << -5.0 * kDeg, 5.0 * kDeg, -5.0 * kDeg;
+  cases.push_back({"x_camr angles -5/+5/-5 deg", e});
+  e = paper;
+  e(7) = 0.15;  // yr -0.30 guessed -0.15
+  cases.push_back({"baseline 50 % short", e});
+  e(7) = -0.15;
+  cases.push_back({"baseline 50 % long", e});
+  std::cout << "| start | fit | seed | re-seeded at | within 3 sigma from frame 30 | max z | "
+               "x_camr at the end |\n|---|---|---|---|---|---|---|\n";
+  // OSC_STEREO_FIT_ON: only off (0) or on (1); OSC_STEREO_FIT_CASE: only case k (0-3).
+  const int only_on = getenv("OSC_STEREO_FIT_ON") ? std::atoi(getenv("OSC_STEREO_FIT_ON")) : -1;
+  const int only_case =
+      getenv("OSC_STEREO_FIT_CASE") ? std::atoi(getenv("OSC_STEREO_FIT_CASE")) : -1;
+  for (size_t k = 0; k < cases.size(); ++k) {
+    if (only_case >= 0 && static_cast<int>(k) != only_case) continue;
+    const Case& c = cases[k];
+    for (int on = 0; on <= 1; ++on) {
+      if (only_on >= 0 && on != only_on) continue;
+      for (int seed = 1; seed <= seeds; ++seed) {
+        const StartRun r = runStart(c.error, frames, on, static_cast<unsigned>(seed));
+        std::printf("| %s | %s | %d | %s | %.2f | %.1f | %.1f mm, %.3f deg |\n", c.name,
+                    on ? "on" : "off", seed,
+                    r.reseeded_at >= 0 ? std::to_string(r.reseeded_at).c_str() : "-",
+                    static_cast<double>(r.within) / std::max(1, r.frames), r.worst,
+                    1e3 * r.last_translation_error, r.last_rotation_error / kDeg);
+        std::fflush(stdout);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace osc
