@@ -559,8 +559,8 @@ TEST(Campaign, OverconfidentConfigurationIsNotHonestTheShippedOneIs) {
 }
 
 TEST(Campaign, InverseDepthPointsKeepAnEasyRunHonestThatPositionsMadeConfidentlyWrong) {
-  // Run 38 of the easy ranges docs/results/campaign/B_clean.yaml (seed 39): a rig looking
-  // backwards on a recorded MAV trajectory, start errors within the prior.
+  // Run 25 of the easy ranges docs/results/campaign/B_clean.yaml (seed 26): a 0.56 m rig
+  // looking forward on the recorded EuRoC MAV trajectory, start errors within the prior.
   // Stored as positions, the first points' depths were +-100 % uncertain and non-Gaussian and
   // yaw_r locked in far off within the first frames (docs/RESULTS.md "Inverse-depth points").
   const std::string dir = std::string(OSC_SOURCE_DIR) + "/docs/results/campaign";
@@ -568,7 +568,7 @@ TEST(Campaign, InverseDepthPointsKeepAnEasyRunHonestThatPositionsMadeConfidently
   inputs.ranges_text = readTextFile(dir + "/B_clean.yaml");
   inputs.ranges = parseCampaignRanges(inputs.ranges_text, "B_clean.yaml", dir);
   inputs.frames = 600;  // as the campaign drew it
-  const CampaignRunSpec spec = drawCampaignRun(inputs, 38);
+  const CampaignRunSpec spec = drawCampaignRun(inputs, 25);
   ASSERT_TRUE(spec.error.empty()) << spec.error;
   EstimatorConfig config;
   ASSERT_EQ(config.filter.inverse_depth_points, 1);  // the shipped default
@@ -582,8 +582,8 @@ TEST(Campaign, InverseDepthPointsKeepAnEasyRunHonestThatPositionsMadeConfidently
       << inverse_depth.score.frames_beyond_5sigma << " frames beyond 5, max z "
       << inverse_depth.score.max_z << " on " << inverse_depth.score.max_z_parameter;
   // The old way fails here, so the test can tell.
-  EXPECT_LT(position.score.share_within_3sigma, 0.5);
-  EXPECT_GT(position.score.max_z, 5.0);
+  EXPECT_LT(position.score.share_within_3sigma, 0.5);  // measured: 0 %, yaw_r 48 sigma off
+  EXPECT_GT(position.score.max_z, 10.0);
 }
 
 }  // namespace
