@@ -126,7 +126,9 @@ TEST(PoseBuffer, IncrementTwistsAreTheOdometrysTwistsAtTheImageStamps) {
     EXPECT_EQ(twist_problem, "");
     EXPECT_FALSE(sample.has_twist_covariance);  // all zero: not given
     EXPECT_NE(covariance_problem, "");
-    if (buffer.newest()) EXPECT_EQ(unsetTwistProblem(sample, *buffer.newest()), "");
+    if (buffer.newest()) {
+      EXPECT_EQ(unsetTwistProblem(sample, *buffer.newest()), "");
+    }
     ASSERT_TRUE(buffer.add(sample));
   }
   // Image stamps between odometry stamps, and on one.
