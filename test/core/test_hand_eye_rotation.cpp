@@ -255,8 +255,9 @@ TEST(HandEyeStart, BackwardAndSidewaysCamerasGuessedForwardConverge) {
       continue;
     }
     // The hand-eye start itself, without the time-offset state: with it (the default) these
-    // drives, which have no offset, are within 3 sigma in 223/205/243 of 250 frames instead of
-    // 250/243/248, none beyond 5 sigma (docs/RESULTS.md "Hand-eye start"; issue 15 note).
+    // drives, which have no offset, are within 3 sigma in 244/224/245 of 250 frames instead of
+    // 249/232/250, none beyond 5 sigma (inverse-depth points; with positions 223/205/243
+    // against 250/243/248; docs/RESULTS.md "Hand-eye start"; issue 15 note).
     FilterConfig config;
     config.initial_time_offset_sigma = 0.0;
     const Scored s = score(mountedScenario(mounting, 300), config, 50);
