@@ -1,6 +1,8 @@
 // The structured filter: agreement with a plain dense UKF of the same model, point
 // initialisation against Monte Carlo, and bad input.
 #include <cmath>
+#include <functional>
+#include <optional>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -8,6 +10,7 @@
 
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
 #include "online_stereo_calibration/core/filter/dense_calibration_ukf.h"
+#include "online_stereo_calibration/core/filter/point_coordinates.h"
 #include "online_stereo_calibration/core/filter/process_model.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
 
@@ -147,6 +150,50 @@ TEST(CalibrationFilter, AgreesWithDenseUkfSharedMotionNoise) {
   expectFiltersAgree(MotionNoiseModel::kShared);
 }
 
+/// A new point's statistics by sampling: x_camr drawn from @p prior's x_camr block about
+/// @p rig, 0.5 px of noise on each pixel of @p z, through @p triangulate (which must succeed).
+struct NewPointSamples {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  Eigen::Matrix<double, 3, 6> cross = Eigen::Matrix<double, 3, 6>::Zero();  ///< with x_camr
+  bool all_triangulated = true;
+};
+using Triangulation =
+    std::function<std::optional<Eigen::Vector3d>(const Eigen::Vector4d&, const Eigen::Isometry3d&)>;
+NewPointSamples sampleNewPoint(const Eigen::Vector4d& z, const StereoExtrinsics& rig,
+                               const Matrix12d& prior, const Triangulation& triangulate,
+                               std::mt19937_64* rng) {
+  const Eigen::Matrix<double, 6, 6> L = prior.block<6, 6>(6, 6).llt().matrixL();
+  std::normal_distribution<double> n01;
+  const int samples = 100000;
+  NewPointSamples out;
+  std::vector<std::pair<Vector6d, Eigen::Vector3d>> draws;
+  for (int s = 0; s < samples; ++s) {
+    Vector6d w;
+    for (int k = 0; k < 6; ++k) w(k) = n01(*rng);
+    const Vector6d dr = L * w;
+    Eigen::Vector4d noisy = z;
+    for (int k = 0; k < 4; ++k) noisy(k) += 0.5 * n01(*rng);
+    StereoExtrinsics e = rig;
+    e.T_caml_camr = boxPlus(e.T_caml_camr, dr);
+    const auto p = triangulate(noisy, e.leftToRightOptical());
+    if (!p) {
+      out.all_triangulated = false;
+      return out;
+    }
+    draws.emplace_back(dr, *p);
+    out.mean += *p;
+  }
+  out.mean /= samples;
+  for (const auto& d : draws) {
+    out.covariance += (d.second - out.mean) * (d.second - out.mean).transpose();
+    out.cross += (d.second - out.mean) * d.first.transpose();
+  }
+  out.covariance /= samples - 1;
+  out.cross /= samples - 1;
+  return out;
+}
+
 TEST(CalibrationFilter, NewPointCrossCovarianceMatchesMonteCarlo) {
   // Sec. II-A: the point's covariance and its cross-covariance with x_camr come out of the
   // SUT through triangulation. Check both against sampling the same inputs.
@@ -160,40 +207,58 @@ TEST(CalibrationFilter, NewPointCrossCovarianceMatchesMonteCarlo) {
   ASSERT_TRUE(filter.addPoint(m));
   const Eigen::MatrixXd joint = filter.denseCovariance();
 
-  const Eigen::Matrix<double, 6, 6> P_rr = guessCovariance().block<6, 6>(6, 6);
-  const Eigen::Matrix<double, 6, 6> L = P_rr.llt().matrixL();
-  std::normal_distribution<double> n01;
-  const int samples = 100000;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  std::vector<std::pair<Vector6d, Eigen::Vector3d>> draws;
-  for (int s = 0; s < samples; ++s) {
-    Vector6d w, dr;
-    for (int k = 0; k < 6; ++k) w(k) = n01(problem.rng);
-    dr = L * w;
-    Eigen::Vector4d z = m.z;
-    for (int k = 0; k < 4; ++k) z(k) += 0.5 * n01(problem.rng);
-    StereoExtrinsics e = problem.guess;
-    e.T_caml_camr = boxPlus(e.T_caml_camr, dr);
-    const auto p = triangulateStereo(z, e.leftToRightOptical(), problem.K);
-    ASSERT_TRUE(p.has_value());
-    draws.emplace_back(dr, *p);
-    mean += *p;
-  }
-  mean /= samples;
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  Eigen::Matrix<double, 3, 6> cross = Eigen::Matrix<double, 3, 6>::Zero();
-  for (const auto& d : draws) {
-    cov += (d.second - mean) * (d.second - mean).transpose();
-    cross += (d.second - mean) * d.first.transpose();
-  }
-  cov /= samples - 1;
-  cross /= samples - 1;
+  const NewPointSamples sampled = sampleNewPoint(
+      m.z, problem.guess, guessCovariance(),
+      [&](const Eigen::Vector4d& z, const Eigen::Isometry3d& T_lopt_ropt) {
+        return triangulateStereo(z, T_lopt_ropt, problem.K);
+      },
+      &problem.rng);
+  ASSERT_TRUE(sampled.all_triangulated);
   const Eigen::Vector3d ut_mean = filter.points().front().position_lopt;
-  EXPECT_LT((ut_mean - mean).norm(), 0.1 * std::sqrt(cov.trace()));
-  EXPECT_LT((joint.block<3, 3>(12, 12) - cov).norm(), 0.1 * cov.norm());
-  EXPECT_LT((joint.block<3, 6>(12, 6) - cross).norm(), 0.1 * cross.norm());
+  EXPECT_LT((ut_mean - sampled.mean).norm(), 0.1 * std::sqrt(sampled.covariance.trace()));
+  EXPECT_LT((joint.block<3, 3>(12, 12) - sampled.covariance).norm(),
+            0.1 * sampled.covariance.norm());
+  EXPECT_LT((joint.block<3, 6>(12, 6) - sampled.cross).norm(), 0.1 * sampled.cross.norm());
   // No direct dependence on x_caml: that block is zero here (prior has no caml-camr correlation).
   EXPECT_LT((joint.block<3, 6>(12, 0).norm()), 1e-12);
+}
+
+TEST(CalibrationFilter, NewFarInverseDepthPointUnderAWideRightCameraPriorMatchesMonteCarlo) {
+  // 30 m ahead on the 0.3 m rig is 6 px of disparity; x_camr's rotation is 1 deg uncertain
+  // (10 px): the depth is undetermined, its inverse is Gaussian. The filter's new point
+  // (inverse_depth_points, point_coordinates.h) must agree with sampling the same inputs.
+  SmallProblem problem(1, 1);
+  FilterConfig config = configOfTheDenseReference();
+  config.inverse_depth_points = 1;  // the joint below is [12, (a, b, rho)]
+  CalibrationFilter filter(config, problem.K);
+  Vector12d sigma;
+  sigma << 0.1, 0.1, 0.1, 2 * kDeg, 2 * kDeg, 2 * kDeg, 0.02, 0.02, 0.02, 1 * kDeg, 1 * kDeg,
+      1 * kDeg;
+  const Matrix12d prior = sigma.array().square().matrix().asDiagonal();
+  filter.reset(problem.truth, prior);
+  PointMeasurement m;
+  m.id = 1;
+  ASSERT_TRUE(projectStereo(Eigen::Vector3d(1.0, 0.5, 30.0),
+                            problem.truth.leftToRightOptical().inverse(), problem.K, 0.1, &m.z));
+  m.variance.setConstant(0.25);
+  ASSERT_TRUE(filter.addPoint(m));
+  const Eigen::MatrixXd joint = filter.denseCovariance();
+  const Eigen::Vector3d ut_mean =
+      PointCoordinates(true).fromPosition(filter.points()[0].position_lopt);
+
+  const NewPointSamples sampled = sampleNewPoint(
+      m.z, problem.truth, prior,
+      [&](const Eigen::Vector4d& z, const Eigen::Isometry3d& T_lopt_ropt) {
+        return triangulateInverseDepth(z, T_lopt_ropt, problem.K);
+      },
+      &problem.rng);
+  ASSERT_TRUE(sampled.all_triangulated);
+  const double rho_sigma = std::sqrt(sampled.covariance(2, 2));
+  ASSERT_GT(rho_sigma, sampled.mean.z());  // the inverse depth really is undetermined
+  EXPECT_LT(std::abs(ut_mean.z() - sampled.mean.z()), 0.1 * rho_sigma);
+  EXPECT_LT((joint.block<3, 3>(12, 12) - sampled.covariance).norm(),
+            0.1 * sampled.covariance.norm());
+  EXPECT_LT((joint.block<3, 6>(12, 6) - sampled.cross).norm(), 0.1 * sampled.cross.norm());
 }
 
 /// A filter with points after a few steps, for the bad-input tests.

@@ -1,16 +1,14 @@
 // Inverse-depth points (FilterConfig::inverse_depth_points): the conversions, the models on
-// homogeneous points, inverse-depth triangulation, and a new far point's uncertainty under a
-// wide x_camr prior against Monte Carlo.
+// homogeneous points and inverse-depth triangulation. (A new far point's uncertainty against
+// Monte Carlo is in test_calibration_filter.cpp.)
 #include <cmath>
-#include <random>
 
 #include <gtest/gtest.h>
-#include <Eigen/Cholesky>
 
-#include "online_stereo_calibration/core/filter/calibration_filter.h"
 #include "online_stereo_calibration/core/filter/measurement_model.h"
 #include "online_stereo_calibration/core/filter/point_coordinates.h"
 #include "online_stereo_calibration/core/filter/process_model.h"
+#include "online_stereo_calibration/core/geometry/pose.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
 
 namespace osc {
@@ -112,68 +110,6 @@ TEST(PointCoordinates, InverseDepthTriangulationIsExactAndDefinedBeyondInfinity)
   ASSERT_TRUE(beyond.has_value());
   EXPECT_LT(beyond->z(), 0.0);
   EXPECT_GT(beyond->z(), -0.01);
-}
-
-TEST(PointCoordinates, NewFarPointUnderAWideRightCameraPriorMatchesMonteCarlo) {
-  // 30 m ahead on a 0.3 m rig is 6 px of disparity; x_camr's rotation is 1 deg uncertain
-  // (10 px): the depth is undetermined, its inverse is Gaussian. The filter's new point (a
-  // UT through triangulation, Sec. II-A) must agree with sampling the same inputs, in the
-  // mean, the covariance and the cross-covariance with x_camr.
-  const StereoIntrinsics K = intrinsics600();
-  const StereoExtrinsics rig = smallRig();
-  FilterConfig config;
-  config.initial_time_offset_sigma = 0.0;
-  config.odometry_velocity_bias_sigma = 0.0;
-  config.inverse_depth_points = 1;
-  CalibrationFilter filter(config, K);
-  Vector12d sigma;
-  sigma << 0.1, 0.1, 0.1, 2 * kDeg, 2 * kDeg, 2 * kDeg, 0.02, 0.02, 0.02, 1 * kDeg, 1 * kDeg,
-      1 * kDeg;
-  const Matrix12d prior = sigma.array().square().matrix().asDiagonal();
-  filter.reset(rig, prior);
-  PointMeasurement m;
-  m.id = 1;
-  ASSERT_TRUE(projectStereo(Eigen::Vector3d(1.0, 0.5, 30.0), rig.leftToRightOptical().inverse(), K,
-                            0.1, &m.z));
-  m.variance.setConstant(0.25);
-  ASSERT_TRUE(filter.addPoint(m));
-  const Eigen::MatrixXd joint = filter.denseCovariance();  // [12, (a, b, rho)]
-  const Eigen::Vector3d ut_mean =
-      PointCoordinates(true).fromPosition(filter.points()[0].position_lopt);
-
-  std::mt19937_64 rng(7);
-  std::normal_distribution<double> n01;
-  const Eigen::Matrix<double, 6, 6> L = prior.block<6, 6>(6, 6).llt().matrixL();
-  const int samples = 100000;
-  std::vector<std::pair<Vector6d, Eigen::Vector3d>> draws;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (int s = 0; s < samples; ++s) {
-    Vector6d w;
-    for (int k = 0; k < 6; ++k) w(k) = n01(rng);
-    const Vector6d dr = L * w;
-    Eigen::Vector4d z = m.z;
-    for (int k = 0; k < 4; ++k) z(k) += 0.5 * n01(rng);
-    StereoExtrinsics e = rig;
-    e.T_caml_camr = boxPlus(e.T_caml_camr, dr);
-    const auto c = triangulateInverseDepth(z, e.leftToRightOptical(), K);
-    ASSERT_TRUE(c.has_value());
-    draws.emplace_back(dr, *c);
-    mean += *c;
-  }
-  mean /= samples;
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  Eigen::Matrix<double, 3, 6> cross = Eigen::Matrix<double, 3, 6>::Zero();
-  for (const auto& d : draws) {
-    cov += (d.second - mean) * (d.second - mean).transpose();
-    cross += (d.second - mean) * d.first.transpose();
-  }
-  cov /= samples - 1;
-  cross /= samples - 1;
-  // The inverse depth really is undetermined: its sigma is above its mean.
-  ASSERT_GT(std::sqrt(cov(2, 2)), mean.z());
-  EXPECT_LT(std::abs(ut_mean.z() - mean.z()), 0.1 * std::sqrt(cov(2, 2)));
-  EXPECT_LT((joint.block<3, 3>(12, 12) - cov).norm(), 0.1 * cov.norm());
-  EXPECT_LT((joint.block<3, 6>(12, 6) - cross).norm(), 0.1 * cross.norm());
 }
 
 }  // namespace
