@@ -171,6 +171,12 @@ TEST(CameraMotion, RecoversRotationAndTranslationDirectionInTheBodyFrame) {
                    .valid);
 }
 
+/// The mountings of the tests (vehicle -> left camera body [x, y, z, roll, pitch, yaw]): a
+/// camera at the tailgate looking backwards, and at the mirrors looking left and right.
+const Vector6d kBackward = (Vector6d() << -0.8, 0.0, 1.4, 0.0, 0.0, M_PI).finished();
+const Vector6d kLeft = (Vector6d() << 1.0, 0.9, 1.1, 0.0, 0.0, M_PI / 2.0).finished();
+const Vector6d kRight = (Vector6d() << 1.0, -0.9, 1.1, 0.0, 0.0, -M_PI / 2.0).finished();
+
 /// The paper's off-road drive (roll, pitch, slow steering) without its step, the left camera
 /// mounted with x_caml = @p mounting and guessed with the forward mounting's translation and
 /// the identity rotation (campaign_draw.cpp's mountings).
@@ -245,11 +251,7 @@ Scored score(const MeasurementScenario& s, const FilterConfig& config, int first
 // two of three) of the frames and never beyond 5 sigma. Without it the filter ends 60-100 sigma
 // off.
 TEST(HandEyeStart, BackwardAndSidewaysCamerasGuessedForwardConverge) {
-  Vector6d backward, left, right;
-  backward << -0.8, 0.0, 1.4, 0.0, 0.0, M_PI;
-  left << 1.0, 0.9, 1.1, 0.0, 0.0, M_PI / 2.0;
-  right << 1.0, -0.9, 1.1, 0.0, 0.0, -M_PI / 2.0;
-  for (const Vector6d& mounting : {backward, left, right}) {
+  for (const Vector6d& mounting : {kBackward, kLeft, kRight}) {
     if (getenv("OSC_HAND_EYE_ONLY") != nullptr &&
         std::atof(getenv("OSC_HAND_EYE_ONLY")) != mounting(5)) {
       continue;
@@ -280,7 +282,7 @@ TEST(HandEyeStart, BackwardAndSidewaysCamerasGuessedForwardConverge) {
   // Off, the backward camera is never found.
   FilterConfig off;
   off.hand_eye_start = 0;
-  const Scored s = score(mountedScenario(backward, 100), off, 50);
+  const Scored s = score(mountedScenario(kBackward, 100), off, 50);
   EXPECT_EQ(s.restarts, 0);
   EXPECT_GT(s.beyond_5sigma, 40);
 }
@@ -298,9 +300,7 @@ TEST(HandEyeStart, ForwardDriveWithAGoodGuessIsNotRestarted) {
 // The restart starts afresh from the guess: x_caml with the hand-eye rotation and the restart
 // sigmas, x_camr with the covariance the guess came with (here a saved calibration's).
 TEST(HandEyeStart, RestartKeepsTheGuessCovarianceOfTheRightCamera) {
-  Vector6d backward;
-  backward << -0.8, 0.0, 1.4, 0.0, 0.0, M_PI;
-  const MeasurementScenario s = mountedScenario(backward, 40);
+  const MeasurementScenario s = mountedScenario(kBackward, 40);
   MeasurementSimulator simulator(s);
   StereoCalibrationEstimator estimator(FilterConfig(), s.left, s.right, simulator.initialGuess());
   Matrix12d saved = Matrix12d::Zero();
@@ -340,10 +340,7 @@ TEST(HandEyeStart, RestartKeepsTheGuessCovarianceOfTheRightCamera) {
 // hand-eye gets the left images' own keypoint matches (left_motion_matches.h). The rotation is
 // found within 20 pairs and the filter is honest from frame 30.
 TEST(HandEyeStart, ImageLevelBackwardAndSidewaysCamerasGuessedForward) {
-  Vector6d backward, right;
-  backward << -0.8, 0.0, 1.4, 0.0, 0.0, M_PI;
-  right << 1.0, -0.9, 1.1, 0.0, 0.0, -M_PI / 2.0;
-  for (const Vector6d& mounting : {backward, right}) {
+  for (const Vector6d& mounting : {kBackward, kRight}) {
     int determined_at = -1, frames = 0, within = 0, beyond = 0;
     double worst = 0.0;
     runImageScenario(
@@ -374,11 +371,7 @@ TEST(HandEyeStart, ImageLevelBackwardAndSidewaysCamerasGuessedForward) {
 // (60 frames), and KITTI's two real stretches guessed at KITTI's calibration and with yaw_l +
 // 180 deg. Run with --gtest_also_run_disabled_tests.
 TEST(HandEyeStart, DISABLED_ImageLevelReport) {
-  Vector6d backward, left, right;
-  backward << -0.8, 0.0, 1.4, 0.0, 0.0, M_PI;
-  left << 1.0, 0.9, 1.1, 0.0, 0.0, M_PI / 2.0;
-  right << 1.0, -0.9, 1.1, 0.0, 0.0, -M_PI / 2.0;
-  for (const Vector6d& mounting : {backward, left, right}) {
+  for (const Vector6d& mounting : {kBackward, kLeft, kRight}) {
     int determined_at = -1;
     double error_then = 0.0, error_at_40 = 0.0, worst_from_30 = 0.0;
     runImageScenario(mountedScenario(mounting, 60), FilterConfig(), FrontEndConfig(), {},
@@ -443,12 +436,9 @@ TEST(HandEyeStart, DISABLED_Report) {
   };
   std::vector<Case> cases(9);
   const char* only = getenv("OSC_HAND_EYE_CASE");
-  cases[0] = {"backward, guessed forward", Vector6d::Zero(), false, false};
-  cases[0].mounting << -0.8, 0.0, 1.4, 0.0, 0.0, M_PI;
-  cases[1] = {"sideways left, guessed forward", Vector6d::Zero(), false, false};
-  cases[1].mounting << 1.0, 0.9, 1.1, 0.0, 0.0, M_PI / 2.0;
-  cases[2] = {"sideways right, guessed forward", Vector6d::Zero(), false, false};
-  cases[2].mounting << 1.0, -0.9, 1.1, 0.0, 0.0, -M_PI / 2.0;
+  cases[0] = {"backward, guessed forward", kBackward, false, false};
+  cases[1] = {"sideways left, guessed forward", kLeft, false, false};
+  cases[2] = {"sideways right, guessed forward", kRight, false, false};
   cases[3] = {"backward, guessed forward, planar", cases[0].mounting, true, false};
   cases[4] = {"sideways left, guessed forward, planar", cases[1].mounting, true, false};
   cases[5] = {"forward, paper start errors", Vector6d::Zero(), false, true};

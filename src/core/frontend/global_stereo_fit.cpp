@@ -62,6 +62,17 @@ double sampson(const Eigen::Matrix3d& E, const Eigen::Vector3d& a, const Eigen::
   return denominator > 0.0 ? b.dot(Ea) / std::sqrt(denominator) : 0.0;
 }
 
+/// The Sampson distances of the ray pairs under E = R_lopt_ropt^T [c]x (normalised units).
+Eigen::VectorXd sampsonDistances(const Eigen::Matrix3d& R_lopt_ropt, const Eigen::Vector3d& c,
+                                 const std::vector<Eigen::Vector3d>& left,
+                                 const std::vector<Eigen::Vector3d>& right) {
+  const Eigen::Matrix3d E = R_lopt_ropt.transpose() * skew(c);
+  Eigen::VectorXd r(static_cast<Eigen::Index>(left.size()));
+  for (size_t i = 0; i < left.size(); ++i)
+    r(static_cast<Eigen::Index>(i)) = sampson(E, left[i], right[i]);
+  return r;
+}
+
 struct RotationRefinement {
   Eigen::Matrix3d R_lopt_ropt;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
@@ -77,14 +88,8 @@ RotationRefinement refineRotation(const Eigen::Matrix3d& R_start, const Eigen::V
   out.R_lopt_ropt = R_start;
   const int n = static_cast<int>(left.size());
   if (n < 4) return out;
-  Eigen::Matrix3d c_cross;
-  c_cross << 0, -c.z(), c.y(), c.z(), 0, -c.x(), -c.y(), c.x(), 0;
   const auto residuals = [&](const Eigen::Matrix3d& R_lopt_ropt) {
-    const Eigen::Matrix3d E = R_lopt_ropt.transpose() * c_cross;
-    Eigen::VectorXd r(n);
-    for (int i = 0; i < n; ++i)
-      r(i) = sampson(E, left[static_cast<size_t>(i)], right[static_cast<size_t>(i)]);
-    return r;
+    return sampsonDistances(R_lopt_ropt, c, left, right);
   };
   constexpr double kStep = 1e-7;  // rad, numeric derivative
   Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
@@ -140,13 +145,8 @@ JointRefinement refineRotationAndDirection(const Eigen::Matrix3d& R_start,
   if (prior_llt.info() != Eigen::Success) return out;
   const Eigen::Matrix2d W = prior_llt.matrixL().solve(Eigen::Matrix2d::Identity());
   const auto residuals = [&](const Eigen::Matrix3d& R_lopt_ropt, const Eigen::Vector2d& d) {
-    const Eigen::Vector3d c = (c0 + out.B * d).normalized();
-    Eigen::Matrix3d c_cross;
-    c_cross << 0, -c.z(), c.y(), c.z(), 0, -c.x(), -c.y(), c.x(), 0;
-    const Eigen::Matrix3d E = R_lopt_ropt.transpose() * c_cross;
     Eigen::VectorXd r(n + 2);
-    for (int i = 0; i < n; ++i)
-      r(i) = sampson(E, left[static_cast<size_t>(i)], right[static_cast<size_t>(i)]) / s;
+    r.head(n) = sampsonDistances(R_lopt_ropt, (c0 + out.B * d).normalized(), left, right) / s;
     r.tail<2>() = W * d;
     return r;
   };

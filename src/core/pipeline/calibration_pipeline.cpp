@@ -19,11 +19,6 @@ namespace {
 /// may be a glitch (blur, an occlusion, a bad exposure).
 constexpr int kKnockedPairsBeforeReopening = 2;
 
-/// Pairs in which the stereo fit is tried after a start or a re-opening (0: off).
-int stereoFitAttempts(const FilterConfig& config) {
-  return config.stereo_fit_start ? config.stereo_fit_attempts : 0;
-}
-
 }  // namespace
 
 CalibrationPipeline::CalibrationPipeline(const FilterConfig& filter_config,
@@ -36,7 +31,7 @@ CalibrationPipeline::CalibrationPipeline(const FilterConfig& filter_config,
       front_end_(std::make_unique<StereoFrontEnd>(
           front_end_config, filter_config, estimator_->leftCamera(), estimator_->rightCamera())),
       filter_config_(filter_config) {
-  stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
+  armStereoFit(false);
 }
 
 CalibrationPipeline::~CalibrationPipeline() = default;
@@ -116,8 +111,7 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
     result.right_camera_reopened = true;
     // The next pairs' whole-image fit re-seeds the re-opened rotation (its wide sigma is no
     // evidence for the old mean, and the fit linearises the filter near the new one).
-    stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
-    stereo_fit_after_reopening_ = true;
+    armStereoFit(true);
     result.status = why +
                     ": x_camr's rotation re-opened (a knocked right camera?), tracking "
                     "restarted";
@@ -245,6 +239,12 @@ bool CalibrationPipeline::seedRightRotationFromFit(std::string* message) {
   return true;
 }
 
+void CalibrationPipeline::armStereoFit(bool after_reopening) {
+  stereo_fit_attempts_left_ =
+      filter_config_.stereo_fit_start ? filter_config_.stereo_fit_attempts : 0;
+  stereo_fit_after_reopening_ = after_reopening;
+}
+
 void CalibrationPipeline::restartFrontEnd() {
   front_end_->reset();
   pairs_without_stereo_ = pairs_off_their_lines_ = fits_contradicting_ = 0;
@@ -258,16 +258,14 @@ void CalibrationPipeline::resetTracking() {
 void CalibrationPipeline::reset(const StereoExtrinsics& guess) {
   estimator_->reset(guess);
   restartFrontEnd();
-  stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
-  stereo_fit_after_reopening_ = false;
+  armStereoFit(false);
 }
 
 void CalibrationPipeline::reset(const StereoExtrinsics& guess,
                                 const Matrix12d& tangent_covariance) {
   estimator_->reset(guess, tangent_covariance);
   restartFrontEnd();
-  stereo_fit_attempts_left_ = stereoFitAttempts(filter_config_);
-  stereo_fit_after_reopening_ = false;
+  armStereoFit(false);
 }
 
 CalibrationEstimate CalibrationPipeline::estimate() const { return estimator_->estimate(); }

@@ -106,6 +106,9 @@ class CalibrationPipeline {
   /// re-opening: always), re-seeds x_camr from the fit (rightRotationSeed). True if it did;
   /// @p message then says what changed. A valid fit ends the attempts.
   bool seedRightRotationFromFit(std::string* message);
+  /// Arms the stereo fit for the next pairs (FilterConfig::stereo_fit_*): after a start, or
+  /// @p after_reopening of x_camr's rotation.
+  void armStereoFit(bool after_reopening);
   /// Counts pairs in which no stereo pair was found although both images had features; true
   /// (a knocked right camera) from the second in a row.
   bool lostTheStereoGeometry(const FrontEndStatistics& stats);
