@@ -372,6 +372,34 @@ TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
   EXPECT_EQ(summary.find("run 4  seed"), std::string::npos) << summary;
 }
 
+TEST(Campaign, AYawStepOfTheLeftCameraOnAFlatRoadIsDetectedThoughZlStaysOpen) {
+  // Run 121 of the shipped ranges (config/campaign.yaml, seed 122): a sideways-left camera on
+  // an urban (planar) drive, x_caml yawed by -4.8 deg at frame 301. zl cannot be determined on
+  // a flat road, so its sigma stays far above the re-opened jump_translation_sigma; when that
+  // alone kept a block from being re-opened, the step's frame gated out every point, nothing
+  // was re-opened and yaw_l stayed ~100 sigma off for the rest of the drive.
+  const std::string dir = std::string(OSC_SOURCE_DIR) + "/config";
+  CampaignInputs inputs;
+  inputs.ranges_text = readTextFile(dir + "/campaign.yaml");
+  inputs.ranges = parseCampaignRanges(inputs.ranges_text, "campaign.yaml", dir);
+  inputs.frames = 600;
+  const CampaignRunSpec spec = drawCampaignRun(inputs, 121);
+  ASSERT_TRUE(spec.error.empty()) << spec.error;
+  ASSERT_EQ(spec.settings[22].second, "caml_yaw_step");  // event
+  ASSERT_EQ(spec.settings[8].second, "urban");           // motion
+  EstimatorConfig config;
+  const CampaignRow shipped = runCampaignRun(spec, config, false);
+  config.filter.jump_settle_time = 1e6;  // translations must settle first, as before
+  const CampaignRow translations_first = runCampaignRun(spec, config, false);
+  ASSERT_TRUE(shipped.ok()) << shipped.status;
+  ASSERT_TRUE(translations_first.ok()) << translations_first.status;
+  EXPECT_TRUE(shipped.honest()) << shipped.score.share_within_3sigma << " within 3 sigma, "
+                                << shipped.score.frames_beyond_5sigma << " frames beyond 5, max z "
+                                << shipped.score.max_z << " on " << shipped.score.max_z_parameter;
+  EXPECT_GT(translations_first.score.frames_beyond_5sigma, 100);  // measured: 299
+  EXPECT_EQ(translations_first.score.max_z_parameter, "yaw_l");
+}
+
 }  // namespace
 }  // namespace osc
 

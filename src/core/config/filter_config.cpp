@@ -110,6 +110,9 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "rotation 1 sigma re-opened after a detected jump"),
       real("jump_translation_sigma_m", &C::jump_translation_sigma, 1.0, 0.0, 10.0,
            "translation 1 sigma re-opened after a detected jump"),
+      real("jump_settle_time_s", &C::jump_settle_time, 1.0, 0.0, 1e6,
+           "time after a block's start or re-opening from which its rotation alone decides "
+           "whether a jump can re-open it (a translation the motion cannot tell stays wide)"),
       integer("relinearization_frames", &C::relinearization_frames, 0, 100000,
               "frames between checks whether the estimate left its start (linearisation) "
               "point; 0 = never restart"),

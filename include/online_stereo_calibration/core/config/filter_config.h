@@ -87,6 +87,11 @@ struct FilterConfig {
   int jump_min_points = 8;              ///< ... when at least this many points were tested
   double jump_rotation_sigma = 10.0 * 0.0174532925199432958;  ///< rad, re-opened 1 sigma
   double jump_translation_sigma = 0.02;                       ///< m, re-opened 1 sigma
+  /// s since a block was started or re-opened after which its rotation alone decides
+  /// whether it can be re-opened again: a translation the motion cannot determine (zl on a
+  /// flat road) never gets below jump_translation_sigma, and before this change an x_caml
+  /// yaw step on urban drives was never detected (CalibrationFilter::canReopen).
+  double jump_settle_time = 5.0;
 
   // --- re-linearisation after a start or a re-opening (issue 14) ---
   /// Every this many frames after a start (or a re-opened block), the estimator compares the

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -149,7 +150,7 @@ class CalibrationFilter {
   struct TrackedPoint {
     PointId id = 0;
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();  ///< in coordinates_
-    Eigen::MatrixXd B;  ///< 3 x G regression on the global error
+    Eigen::MatrixXd B;                               ///< 3 x G regression on the global error
     Eigen::Matrix3d D = Eigen::Matrix3d::Zero();
   };
   struct PointInnovation;  // defined in the .cpp
@@ -211,6 +212,9 @@ class CalibrationFilter {
   /// kTwistTrendIncrements (twistsAtEnds).
   std::vector<MotionIncrement> previous_motions_;
   MotionExcitation excitation_;
+  /// s of accepted motion since each block (x_caml, x_camr) was started or widened
+  /// (canReopen).
+  std::array<double, 2> time_since_opened_ = {0.0, 0.0};
   PointCoordinates coordinates_;  ///< how TrackedPoint::mean stores a point
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;
