@@ -96,6 +96,8 @@ const std::vector<ParameterSpec>& filterParameterTable() {
       integer("max_points", &C::max_points, 1, 100000, "points kept in the filter state"),
       integer("inverse_depth_points", &C::inverse_depth_points, 0, 1,
               "1: points as inverse depth (x/z, y/z, 1/z), 0: as positions (the seed's)"),
+      integer("baseline_scaled_points", &C::baseline_scaled_points, 0, 1,
+              "1: points in units of the baseline (what stereo measures), 0: metric (the seed's)"),
       real("max_speed_mps", &C::max_speed, 1.0, 0.0, 1e4,
            "a motion increment faster than this is rejected as corrupt"),
       real("max_angular_rate_dps", &C::max_angular_rate, kDeg, 0.0, 1e5,
@@ -241,6 +243,7 @@ FilterConfig paperFilterConfig() {
   config.odometry_scale_sigma = 0.0;          // ... and exact in scale
   config.odometry_velocity_bias_sigma = 0.0;  // ... and without a velocity error
   config.inverse_depth_points = 0;            // the paper's points are positions
+  config.baseline_scaled_points = 0;          // ... in metres
   return config;
 }
 

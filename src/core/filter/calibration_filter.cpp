@@ -78,6 +78,15 @@ bool unscentedTransformWithFallback(const VectorXd& mean, const MatrixXd& covari
   return false;
 }
 
+/// A homogeneous point [d; w] stored in units of a length @p scale (the point p / scale) as
+/// one in metres ([d; w / scale]), and back (FilterConfig::baseline_scaled_points).
+HomogeneousPoint metricFromScaled(const HomogeneousPoint& h, double scale) {
+  return HomogeneousPoint(h.x(), h.y(), h.z(), h.w() / scale);
+}
+HomogeneousPoint scaledFromMetric(const HomogeneousPoint& h, double scale) {
+  return HomogeneousPoint(h.x(), h.y(), h.z(), h.w() * scale);
+}
+
 std::vector<int> range(int first, int count) {
   std::vector<int> r(count);
   for (int k = 0; k < count; ++k) r[k] = first + k;
@@ -342,6 +351,14 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
     const std::vector<int> motion_block = range(persistentDim(), layout::kPoseDim);
     selected.insert(selected.end(), motion_block.begin(), motion_block.end());
   }
+  // Points in units of the baseline: the camera's metric motion moves them by translation /
+  // |t_r|, so x_camr's translation is an input of the prediction.
+  const bool scaled = config_.baseline_scaled_points != 0;
+  const int baseline_offset = static_cast<int>(selected.size());
+  if (scaled) {
+    const std::vector<int> baseline = range(layout::kCamr + layout::kTranslation, 3);
+    selected.insert(selected.end(), baseline.begin(), baseline.end());
+  }
   const int s = static_cast<int>(selected.size());
   Eigen::Isometry3d T_motion;
   MatrixXd motion_jacobian;
@@ -352,6 +369,10 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
   const double sigma_imu =
       config_.motion_rotation_noise * std::sqrt(noiseScale(config_, motion.dt));
   const Eigen::Matrix3d R_excited = excitation_.excitedRotation(T_motion.linear());
+  const double point_scale = pointScale();
+  const Eigen::Vector3d baseline_direction =
+      scaled ? Eigen::Vector3d(extrinsics_.T_caml_camr.translation() / point_scale)
+             : Eigen::Vector3d::Zero();
 
   for (size_t i = 0; i < points_.size(); ++i) {
     TrackedPoint& point = points_[i];
@@ -363,9 +384,19 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
       if (o > 0) motion_error = motion_jacobian * x.segment(6, o);
       if (shared) motion_error += x.segment<6>(6 + o);
       const Eigen::Isometry3d T_prev_curr = boxPlus(T_motion, motion_error);
-      const HomogeneousPoint moved =
-          predictHomogeneousPoint(coordinates_.homogeneous(mean + x.tail<3>()), T_veh_lopt,
-                                  T_prev_curr, x.head<3>(), R_excited);
+      // [d; w] in units of the baseline s moves as [A d + c w / s; w] (c: the metric image
+      // of the origin, predictHomogeneousPoint). 1 / s to first order in the baseline's
+      // error: exact at the estimate, and finite for a sigma point of a baseline prior as
+      // wide as the baseline itself (where 1 / s has no useful Gaussian approximation).
+      HomogeneousPoint point_h = coordinates_.homogeneous(mean + x.tail<3>());
+      const double w = point_h.w();
+      if (scaled) {
+        const double ds = baseline_direction.dot(x.segment<3>(baseline_offset));
+        point_h.w() *= (1.0 - ds / point_scale) / point_scale;
+      }
+      HomogeneousPoint moved =
+          predictHomogeneousPoint(point_h, T_veh_lopt, T_prev_curr, x.head<3>(), R_excited);
+      moved.w() = w;
       Eigen::Vector3d coordinates;
       if (!coordinates_.fromHomogeneous(moved, &coordinates)) return false;
       *y = coordinates;
@@ -380,12 +411,12 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
     const Eigen::Matrix3d F_p = ut.jacobian.rightCols<3>();
     MatrixXd B = F_p * point.B;
     for (int a = 0; a < s; ++a) B.col(selected[a]) += ut.jacobian.col(a);
-    Eigen::Matrix3d Q = sigma_p2 * Eigen::Matrix3d::Identity();  // of the position
+    Eigen::Matrix3d Q = sigma_p2 * Eigen::Matrix3d::Identity();  // of the position (m^2)
     if (!shared)
       Q = paperPointProcessNoise(
-          coordinates_.position(mean, minInverseDepth()), sigma_imu,
+          point_scale * coordinates_.position(mean, minInverseDepth() * point_scale), sigma_imu,
           config_.point_position_noise * std::sqrt(noiseScale(config_, motion.dt)));
-    const Eigen::Matrix3d J = coordinates_.jacobianFromPosition(ut.mean);
+    const Eigen::Matrix3d J = coordinates_.jacobianFromPosition(ut.mean) / point_scale;
     Q = J * Q * J.transpose();
     point.D = F_p * point.D * F_p.transpose() + ut.residual + Q;
     point.D = 0.5 * (point.D + point.D.transpose());
@@ -669,11 +700,14 @@ bool CalibrationFilter::linearizeMeasurement(size_t i, const MatrixXd& P, const 
   const TrackedPoint& point = points_[i];
   const std::vector<int> camr = range(layout::kCamr, layout::kPoseDim);
   const VectorFunction observe = [&](const VectorXd& x, VectorXd* y) {
-    const Eigen::Isometry3d T_ropt_lopt =
-        leftToRightOptical(boxPlus(extrinsics_.T_caml_camr, x.head<6>())).inverse();
+    const Eigen::Isometry3d T_caml_camr = boxPlus(extrinsics_.T_caml_camr, x.head<6>());
+    const Eigen::Isometry3d T_ropt_lopt = leftToRightOptical(T_caml_camr).inverse();
+    const double scale = pointScale(T_caml_camr);
+    if (!(scale > 0.0)) return false;
     Eigen::Vector4d projected;
-    if (!projectHomogeneousStereo(coordinates_.homogeneous(point.mean + x.tail<3>()), T_ropt_lopt,
-                                  intrinsics_, 1e-3, &projected))
+    if (!projectHomogeneousStereo(
+            metricFromScaled(coordinates_.homogeneous(point.mean + x.tail<3>()), scale),
+            T_ropt_lopt, intrinsics_, 1e-3, &projected))
       return false;
     *y = projected;
     return true;
@@ -864,23 +898,33 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
   C.bottomRightCorner<4, 4>() = m.variance.asDiagonal();
   const double min_depth = config_.min_point_depth, max_depth = config_.max_point_depth;
   const VectorFunction triangulate = [&](const VectorXd& x, VectorXd* y) {
-    const Eigen::Isometry3d T_lopt_ropt =
-        leftToRightOptical(boxPlus(extrinsics_.T_caml_camr, x.head<6>()));
+    const Eigen::Isometry3d T_caml_camr = boxPlus(extrinsics_.T_caml_camr, x.head<6>());
+    const Eigen::Isometry3d T_lopt_ropt = leftToRightOptical(T_caml_camr);
+    const double scale = pointScale(T_caml_camr);
+    if (!(scale > 0.0)) return false;
+    Eigen::Vector3d metric;
     if (coordinates_.inverseDepth()) {
       // Any disparity has an inverse depth: a sigma point beyond infinity is still one.
       const auto c = triangulateInverseDepth(m.z + x.tail<4>(), T_lopt_ropt, intrinsics_);
       if (!c || c->z() > 2.0 / min_depth) return false;
-      *y = *c;
-      return true;
+      metric = *c;
+    } else {
+      const auto p = triangulateStereo(m.z + x.tail<4>(), T_lopt_ropt, intrinsics_);
+      if (!p || p->z() < 0.5 * min_depth || p->z() > 2.0 * max_depth) return false;
+      metric = *p;
     }
-    const auto p = triangulateStereo(m.z + x.tail<4>(), T_lopt_ropt, intrinsics_);
-    if (!p || p->z() < 0.5 * min_depth || p->z() > 2.0 * max_depth) return false;
-    *y = *p;
+    // In units of this sigma point's baseline: a function of the pixels and x_camr's
+    // rotation and direction only (the disparity), not of the baseline's length.
+    Eigen::Vector3d stored;
+    if (!coordinates_.fromHomogeneous(scaledFromMetric(coordinates_.homogeneous(metric), scale),
+                                      &stored))
+      return false;
+    *y = stored;
     return true;
   };
   UnscentedResult ut;
   if (!unscentedTransformWithFallback(VectorXd::Zero(10), C, triangulate, ut_, &ut)) return false;
-  const double depth = coordinates_.depth(ut.mean);
+  const double depth = coordinates_.depth(ut.mean) * pointScale();
   if (!(depth >= min_depth && depth <= max_depth)) return false;
   TrackedPoint point;
   point.id = m.id;
@@ -912,19 +956,32 @@ Matrix12d CalibrationFilter::parameterCovariance() const {
 std::vector<PointEstimate> CalibrationFilter::points() const {
   std::vector<PointEstimate> result;
   result.reserve(points_.size());
+  // Metres = scale * stored position; the scale (the baseline's length) is uncertain too:
+  // d scale = u^T dt_r (u: the baseline's direction; boxPlus adds translations).
+  const double scale = pointScale();
+  const double min_inverse_depth = minInverseDepth() * scale;
+  MatrixXd scale_row = MatrixXd::Zero(1, covariance_.rows());
+  if (config_.baseline_scaled_points != 0 && scale > 0.0) {
+    scale_row.middleCols<3>(layout::kCamr + layout::kTranslation) =
+        extrinsics_.T_caml_camr.translation().transpose() / scale;
+  }
   for (const TrackedPoint& point : points_) {
     PointEstimate e;
     e.id = point.id;
-    e.position_lopt = coordinates_.position(point.mean, minInverseDepth());
-    // Cov(position) = J^-1 Cov(c) J^-T, J = d c / d position (a far point: clamped as above).
+    const Eigen::Vector3d stored = coordinates_.position(point.mean, min_inverse_depth);
+    e.position_lopt = scale * stored;
+    // Cov(position) = J^-1 Cov(c) J^-T, J = d c / d position (a far point: clamped as above),
+    // plus the scale's share.
     Eigen::Matrix3d J_inverse = Eigen::Matrix3d::Identity();
     if (coordinates_.inverseDepth()) {
       Eigen::Vector3d clamped = point.mean;
-      clamped.z() = std::max(clamped.z(), minInverseDepth());
+      clamped.z() = std::max(clamped.z(), min_inverse_depth);
       J_inverse = coordinates_.jacobianFromPosition(clamped).inverse();
     }
-    e.covariance =
-        J_inverse * (point.B * covariance_ * point.B.transpose() + point.D) * J_inverse.transpose();
+    const MatrixXd M =
+        scale * J_inverse * point.B.leftCols(covariance_.cols()) + stored * scale_row;
+    e.covariance = M * covariance_ * M.transpose() +
+                   scale * scale * J_inverse * point.D * J_inverse.transpose();
     result.push_back(e);
   }
   return result;

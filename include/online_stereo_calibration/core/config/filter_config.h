@@ -76,6 +76,15 @@ struct FilterConfig {
   /// uncertainty stays close to Gaussian while the depth is +-100 % uncertain (a new point
   /// under a wide x_camr prior, a far point); 0: as positions (x, y, z), the seed's choice.
   int inverse_depth_points = 1;
+  /// 1: points are stored in units of the baseline (the left-to-right camera distance |t_r|):
+  /// a point p is kept as p / |t_r|, which is what a stereo pair measures. Two images of a
+  /// static scene then say nothing about the baseline, exactly and at any linearisation
+  /// point; the baseline enters only where it physically does, through the metric motion
+  /// (the camera's translation / |t_r|). 0: metric points (the seed's): a point's regression
+  /// on the baseline (depth ~ 1 / |t_r|) is a linearisation that is not re-evaluated as the
+  /// estimate moves, and re-looks at points then "measure" the baseline (a slow drone: yr
+  /// 100 mm off with a 4 mm sigma after three frames; docs/RESULTS.md).
+  int baseline_scaled_points = 1;
 
   // --- input sanity ---
   double max_speed = 70.0;          ///< m/s; a motion increment faster than this is rejected

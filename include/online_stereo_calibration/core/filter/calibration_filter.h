@@ -137,7 +137,8 @@ class CalibrationFilter {
   std::vector<PointEstimate> points() const;
   /// The full (P + 3N)^2 covariance the structured form represents (P = 12 + the odometry
   /// states), points in the order of points() and in the filter's point coordinates
-  /// (FilterConfig::inverse_depth_points). For tests and diagnostics; O(N^2).
+  /// (FilterConfig::inverse_depth_points, in units of the baseline with
+  /// FilterConfig::baseline_scaled_points). For tests and diagnostics; O(N^2).
   Eigen::MatrixXd denseCovariance() const;
 
   /// The consistency monitor's state: per-block statistics and the drift-noise factors.
@@ -160,6 +161,12 @@ class CalibrationFilter {
   /// The inverse depth (1/m) below which a point is placed, where a position is needed (its
   /// process noise, points()): half that of the farthest new point.
   double minInverseDepth() const { return 0.5 / config_.max_point_depth; }
+  /// The length a stored point is measured in (FilterConfig::baseline_scaled_points): the
+  /// baseline |t_r| of @p T_caml_camr, or 1 (metres) for metric points.
+  double pointScale(const Eigen::Isometry3d& T_caml_camr) const {
+    return config_.baseline_scaled_points != 0 ? T_caml_camr.translation().norm() : 1.0;
+  }
+  double pointScale() const { return pointScale(extrinsics_.T_caml_camr); }
   /// Size of the persistent global error: calibration (12) + odometry states.
   int persistentDim() const { return layout::kCalibrationDim + odometry_dim_; }
   double stateSigma(int index) const {
