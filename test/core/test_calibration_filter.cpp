@@ -2,7 +2,6 @@
 // initialisation against Monte Carlo, and bad input.
 #include <cmath>
 #include <functional>
-#include <iostream>
 #include <optional>
 #include <random>
 
@@ -182,10 +181,9 @@ TEST(CalibrationFilter, StandingRigLearnsNoBaselineFromPointsInUnitsOfTheBaselin
   }
   // Measured: metric 10.3 mm, scaled 29.0 mm of the 30 mm prior (with the 2 deg rotation prior,
   // whose nonlinearity leaves a little; x_camr's translation prior 0.1 m: 7 / 53 mm of 100).
-  std::cout << "sigma yr after 5 standing frames: metric " << sigma_yr[0] << " m, scaled "
-            << sigma_yr[1] << " m (prior 0.03 m)\n";
-  EXPECT_GT(sigma_yr[1], 0.85 * 0.03);
-  EXPECT_LT(sigma_yr[0], 0.65 * 0.03);  // the spurious information the scaling removes
+  EXPECT_GT(sigma_yr[1], 0.85 * 0.03) << "scaled points: sigma yr " << sigma_yr[1] << " m";
+  // The spurious information the scaling removes:
+  EXPECT_LT(sigma_yr[0], 0.65 * 0.03) << "metric points: sigma yr " << sigma_yr[0] << " m";
 }
 
 /// A new point's statistics by sampling: x_camr drawn from @p prior's x_camr block about

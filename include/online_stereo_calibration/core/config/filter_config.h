@@ -102,8 +102,8 @@ struct FilterConfig {
   double jump_translation_sigma = 0.02;                       ///< m, re-opened 1 sigma
   /// s since a block was started or re-opened after which its rotation alone decides
   /// whether it can be re-opened again: a translation the motion cannot determine (zl on a
-  /// flat road) never gets below jump_translation_sigma, and before this change an x_caml
-  /// yaw step on urban drives was never detected (CalibrationFilter::canReopen).
+  /// flat road) never gets below jump_translation_sigma; requiring that as well left an
+  /// x_caml yaw step on urban drives undetected (CalibrationFilter::canReopen).
   double jump_settle_time = 5.0;
 
   // --- re-linearisation after a start or a re-opening (issue 14) ---
