@@ -897,6 +897,7 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
   C.topLeftCorner<6, 6>() = covariance_.block<6, 6>(layout::kCamr, layout::kCamr);
   C.bottomRightCorner<4, 4>() = m.variance.asDiagonal();
   const double min_depth = config_.min_point_depth, max_depth = config_.max_point_depth;
+  const bool scaled = config_.baseline_scaled_points != 0;
   const VectorFunction triangulate = [&](const VectorXd& x, VectorXd* y) {
     const Eigen::Isometry3d T_caml_camr = boxPlus(extrinsics_.T_caml_camr, x.head<6>());
     const Eigen::Isometry3d T_lopt_ropt = leftToRightOptical(T_caml_camr);
@@ -919,20 +920,32 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
     if (!coordinates_.fromHomogeneous(scaledFromMetric(coordinates_.homogeneous(metric), scale),
                                       &stored))
       return false;
-    *y = stored;
+    if (scaled) {
+      // ... and the metric point as well, for the depth check below.
+      y->resize(6);
+      *y << stored, metric;
+    } else {
+      *y = stored;
+    }
     return true;
   };
   UnscentedResult ut;
   if (!unscentedTransformWithFallback(VectorXd::Zero(10), C, triangulate, ut_, &ut)) return false;
-  const double depth = coordinates_.depth(ut.mean) * pointScale();
+  // The depth is judged in metres over the baseline's uncertainty: the mean of the metric
+  // point over the sigma points, as with metric points. (The stored point's mean in units
+  // of the baseline times the mean baseline would not see that baseline: a small rig with a
+  // baseline prior as wide as the baseline would accept points whose metric depth is
+  // unknown to a factor of two or more, and some such runs ended 40-200 sigma off.)
+  const double depth = coordinates_.depth(scaled ? Eigen::Vector3d(ut.mean.tail<3>())
+                                                 : Eigen::Vector3d(ut.mean.head<3>()));
   if (!(depth >= min_depth && depth <= max_depth)) return false;
   TrackedPoint point;
   point.id = m.id;
-  point.mean = ut.mean;
+  point.mean = ut.mean.head<3>();
   point.B = MatrixXd::Zero(3, persistentDim());
-  point.B.middleCols<6>(layout::kCamr) = ut.jacobian.leftCols<6>();
+  point.B.middleCols<6>(layout::kCamr) = ut.jacobian.topLeftCorner<3, 6>();
   // D = Cov(p) - B P B^T: what the calibration does not explain (pixel noise, nonlinearity).
-  MatrixXd D = ut.covariance - point.B * covariance_ * point.B.transpose();
+  MatrixXd D = ut.covariance.topLeftCorner<3, 3>() - point.B * covariance_ * point.B.transpose();
   makeSymmetricPsd(&D, 1e-12);
   point.D = D;
   index_[point.id] = points_.size();
