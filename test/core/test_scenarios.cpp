@@ -158,7 +158,7 @@ MeasurementScenario hoveringSmallRigScenario() {
 // prior, point depths +-100 % uncertain, so the UT of the first re-looks fakes yaw_r.
 // Inverse-depth points (the default since) remove (c): yr ends 5.4 / 2.6 sigma off with a
 // sigma of 1.3-1.5 mm (rotation priors 0.2 / 2 deg); (a) and (b) remain. Points in units of
-// the baseline (FilterConfig::baseline_scaled_points, off by default) remove (a); (b) remains
+// the baseline (FilterConfig::baseline_scaled_points, the default since) remove (a); (b) remains
 // and is then the only channel of the baseline: yr ends 230 / 172 mm off with a sigma of
 // 12 / 10 mm (the prediction linearised at the noisy measured translation; not tried with
 // motion_relinearizations 1).

@@ -84,11 +84,12 @@ struct FilterConfig {
   /// on the baseline (depth ~ 1 / |t_r|) is a linearisation that is not re-evaluated as the
   /// estimate moves, and re-looks at points then "measure" the baseline (a slow drone: yr
   /// 100 mm off with a 4 mm sigma after three frames; docs/RESULTS.md).
-  /// Off by default for now: on the default campaign it makes 81 -> 98 of 200 runs honest,
-  /// but small rigs with a baseline prior as wide as the baseline now accept points and
-  /// some end 40-200 sigma off (runs 102, 126), and the hovering rig ends further off
-  /// (docs/RESULTS.md "Points in units of the baseline").
-  int baseline_scaled_points = 0;
+  /// On by default: the default campaign goes 81 -> 99 of 200 honest runs. A new point's
+  /// depth is judged in metres (the UT mean of its metric triangulation) as with metric
+  /// points, so small rigs under a baseline prior as wide as the baseline do not accept
+  /// points the metric filter would reject (docs/RESULTS.md "Points in units of the
+  /// baseline").
+  int baseline_scaled_points = 1;
 
   // --- input sanity ---
   double max_speed = 70.0;          ///< m/s; a motion increment faster than this is rejected
