@@ -128,6 +128,44 @@ TEST(HandEyeRotation, NoRotationAndTooFewPairsAreNotDetermined) {
   EXPECT_GT(std::abs(straight.weakest_axis_vehicle.x()), 0.99) << straight.reason;
 }
 
+// Default campaign run 192 (a sideways camera, urban, 16 % moving points) was blamed on the
+// hand-eye flipping x_caml by 180 deg. The hand-eye's pairs there: yaw increments of 0.8 deg
+// per frame on a curve, the camera's fitted rotation 0.2-0.3 deg off per axis (moving points),
+// directions along the vehicle's x; it stayed undetermined (1 sigma 2-5 deg about x) until
+// frame ~120-150 and then agreed with the truth within 0.3 deg. The flip was the filter's
+// first update (frame 1), the same with the hand-eye start off. This pins the hand-eye's side:
+// a sideways camera on a flat road with few pairs whose yaw increments are just above
+// min_rotation and a camera fit that noisy is never offered flipped (the rotation about the
+// driving axis, which only the sign of the yaw increments fixes), nor confidently wrong.
+TEST(HandEyeRotation, FewWeakYawPairsOfASidewaysCameraAreNotOfferedFlipped) {
+  const Eigen::Matrix3d X = rotationFromRpy(Eigen::Vector3d(0.0, 0.0, -M_PI / 2));
+  int determined = 0;
+  for (unsigned seed = 1; seed <= 100; ++seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> yaw(0.15 * kDeg, 0.35 * kDeg);
+    HandEyeRotation solver;
+    for (int i = 0; i < 10; ++i) {
+      const Eigen::Matrix3d R_v = expSO3(Eigen::Vector3d(0.0, 0.0, yaw(rng)));
+      solver.addRotationPair(R_v * expSO3(gaussian3(&rng, 0.02 * kDeg)),
+                             X.transpose() * R_v * X * expSO3(gaussian3(&rng, 0.25 * kDeg)));
+      const Eigen::Vector3d t_v(1.2, 0.01 * gaussian3(&rng, 1.0).x(), 0.0);
+      solver.addDirectionPair(t_v,
+                              (X.transpose() * t_v.normalized() + gaussian3(&rng, 0.3 * kDeg)));
+    }
+    const HandEyeRotationResult r = solver.solve();
+    ASSERT_EQ(r.rotation_pairs + r.direction_pairs, 20)
+        << "seed " << seed;  // all above min_rotation
+    // The driving axis is the open one, and it stays open (1 sigma 2-5 deg in run 192).
+    EXPECT_GT(std::abs(r.weakest_axis_vehicle.x()), 0.99) << "seed " << seed << ": " << r.reason;
+    EXPECT_GT(r.max_sigma, HandEyeRotationConfig().max_sigma) << "seed " << seed;
+    if (!r.determined) continue;
+    ++determined;  // (none on the current code; if ever, it must be right)
+    const Eigen::Vector3d error = logSO3(r.R_veh_cam.transpose() * X);
+    EXPECT_LT(error.norm(), 5.0 * kDeg) << "seed " << seed << ": " << r.reason;
+  }
+  EXPECT_EQ(determined, 0);
+}
+
 TEST(HandEyeRotation, IsRobustToAFewOutlierPairs) {
   std::mt19937 rng(10);
   const Eigen::Matrix3d X = rotationFromRpy(Eigen::Vector3d(0.02, 0.03, M_PI));
