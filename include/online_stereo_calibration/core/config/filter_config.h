@@ -144,9 +144,8 @@ struct FilterConfig {
   /// odometry's velocity (wheel slip, a tilted or drifting IMU): a first-order Gauss-Markov
   /// state b with correlation time odometry_bias_correlation_time; the measured translation
   /// over dt is t + b dt. 0 = not estimated. A lateral bias at low speed turns the motion's
-  /// direction, which x_caml's rotation would otherwise absorb. All three axes are states:
-  /// a forward error is a scale error on a car (odometry_scale_sigma), but on a slow
-  /// platform that moves along every axis (a drone) it is not (calibration_filter.cpp).
+  /// direction, which x_caml's rotation would otherwise absorb. Only the lateral and the
+  /// vertical error are states (a forward one is a scale error: odometry_scale_sigma).
   /// On by default (0.01 m/s): a vertical (lateral) velocity error b at speed v tilts the
   /// measured direction of travel by b / v, as a pitched (yawed) camera does, so without
   /// the state x_caml's rotation absorbs it with a sigma that does not know it (default

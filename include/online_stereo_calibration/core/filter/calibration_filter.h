@@ -130,7 +130,8 @@ class CalibrationFilter {
   double timeOffset() const { return time_offset_; }
   double timeOffsetSigma() const { return stateSigma(time_offset_index_); }
   /// The odometry's velocity error state (FilterConfig::odometry_velocity_bias_sigma; m/s,
-  /// vehicle axes) and its 1 sigmas (0 when not estimated).
+  /// vehicle axes; lateral and vertical only, x stays 0) and its 1 sigmas (0 when not
+  /// estimated).
   const Eigen::Vector3d& velocityBias() const { return velocity_bias_; }
   Eigen::Vector3d velocityBiasSigma() const;
   std::vector<PointEstimate> points() const;
