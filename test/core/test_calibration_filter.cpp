@@ -87,6 +87,7 @@ FilterConfig configOfTheDenseReference() {
   FilterConfig config;
   config.initial_time_offset_sigma = 0.0;
   config.odometry_velocity_bias_sigma = 0.0;
+  config.odometry_forward_velocity_bias_sigma = 0.0;
   config.inverse_depth_points = 0;
   config.baseline_scaled_points = 0;
   return config;

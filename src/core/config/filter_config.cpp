@@ -136,7 +136,11 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "random walk of the time offset per reference step"),
       real("odometry_velocity_bias_sigma_mps", &C::odometry_velocity_bias_sigma, 1.0, 0.0, 10.0,
            "steady-state 1 sigma of a slowly varying odometry velocity error, estimated per "
-           "vehicle axis (0 = not estimated)"),
+           "lateral and vertical vehicle axis (0 = not estimated)"),
+      real("odometry_forward_velocity_bias_sigma_mps", &C::odometry_forward_velocity_bias_sigma,
+           1.0, 0.0, 10.0,
+           "the same for the forward vehicle axis (a scale error on a car, not on a drone; 0 = "
+           "not estimated)"),
       real("odometry_bias_correlation_time_s", &C::odometry_bias_correlation_time, 1.0, 0.1, 1e6,
            "correlation time of that velocity error (first-order Gauss-Markov)"),
       real("odometry_scale_sigma_percent", &C::odometry_scale_sigma, 1e-2, 0.0, 50.0,
@@ -242,8 +246,9 @@ FilterConfig paperFilterConfig() {
   config.initial_time_offset_sigma = 0.0;     // the paper takes the odometry as synchronised
   config.odometry_scale_sigma = 0.0;          // ... and exact in scale
   config.odometry_velocity_bias_sigma = 0.0;  // ... and without a velocity error
-  config.inverse_depth_points = 0;            // the paper's points are positions
-  config.baseline_scaled_points = 0;          // ... in metres
+  config.odometry_forward_velocity_bias_sigma = 0.0;
+  config.inverse_depth_points = 0;    // the paper's points are positions
+  config.baseline_scaled_points = 0;  // ... in metres
   return config;
 }
 

@@ -19,17 +19,17 @@ using Eigen::VectorXd;
 
 namespace {
 
-/// The vehicle axes whose velocity error is a state: lateral and vertical. A forward error
-/// at a steady speed is a scale error, which images cannot tell (filter_config.h
-/// odometry_scale_sigma): as a state it would take spurious information from linearisation
-/// and move the baseline with it (measured: clean drives 25 -> 20 of 50 honest, yr). The
-/// vertical one matters most (lateral only: campaign C_odometry 17 -> 4 of 50 honest).
-/// Measured again with points in units of the baseline (session 12): all three axes made
-/// the default campaign 99 -> 101 of 200 honest and C_odometry 32 -> 38 of 50 (a drone's
-/// forward error is no scale error: default run 40, yaw_r 39 sigma -> honest), but
-/// paper_offroad's zl 16.9 mm (pooled seeds 1-3; seed 1: 25 mm), above Table I's 13.2 mm.
-constexpr int kVelocityBiasAxes = 2;
-constexpr int kVelocityBiasAxis[kVelocityBiasAxes] = {1, 2};
+/// Steady-state 1 sigma of the odometry's velocity error along a vehicle axis (0 x forward).
+/// The forward axis has its own (FilterConfig::odometry_forward_velocity_bias_sigma): with
+/// metric points a forward state took spurious information from linearisation and moved the
+/// baseline with it (clean drives 25 -> 20 of 50 honest, yr); with points in units of the
+/// baseline the baseline enters only through the motion, and at half the lateral sigma it
+/// helps (docs/RESULTS.md "Session 12"). The vertical one matters most (lateral only:
+/// campaign C_odometry 17 -> 4 of 50 honest).
+double velocityBiasPriorSigma(const FilterConfig& config, int axis) {
+  return axis == 0 ? config.odometry_forward_velocity_bias_sigma
+                   : config.odometry_velocity_bias_sigma;
+}
 
 /// chi-square(2) at 99.9 %: the left image's share of a stereo innovation.
 constexpr double kLeftGate = 13.82;
@@ -198,9 +198,11 @@ CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoInt
   ut_.kappa = config.ut_kappa;
   if (config.initial_time_offset_sigma > 0.0)
     time_offset_index_ = layout::kOdometry + odometry_dim_++;
-  if (config.odometry_velocity_bias_sigma > 0.0) {
+  for (int axis = 0; axis < 3; ++axis)
+    if (velocityBiasPriorSigma(config, axis) > 0.0) velocity_bias_axes_.push_back(axis);
+  if (!velocity_bias_axes_.empty()) {
     velocity_bias_index_ = layout::kOdometry + odometry_dim_;
-    odometry_dim_ += kVelocityBiasAxes;
+    odometry_dim_ += static_cast<int>(velocity_bias_axes_.size());
   }
   reset(StereoExtrinsics());
 }
@@ -210,18 +212,18 @@ MatrixXd CalibrationFilter::startCovariance(const Matrix12d& calibration) const 
   P.topLeftCorner<12, 12>() = calibration;
   if (time_offset_index_ >= 0)
     P(time_offset_index_, time_offset_index_) = std::pow(config_.initial_time_offset_sigma, 2);
-  for (int k = 0; velocity_bias_index_ >= 0 && k < kVelocityBiasAxes; ++k) {
-    P(velocity_bias_index_ + k, velocity_bias_index_ + k) =
-        std::pow(config_.odometry_velocity_bias_sigma, 2);
+  for (size_t k = 0; k < velocity_bias_axes_.size(); ++k) {
+    const int i = velocity_bias_index_ + static_cast<int>(k);
+    P(i, i) = std::pow(velocityBiasPriorSigma(config_, velocity_bias_axes_[k]), 2);
   }
   return P;
 }
 
 Eigen::Vector3d CalibrationFilter::velocityBiasSigma() const {
   Eigen::Vector3d sigma = Eigen::Vector3d::Zero();
-  for (int k = 0; velocity_bias_index_ >= 0 && k < kVelocityBiasAxes; ++k) {
-    sigma(kVelocityBiasAxis[k]) =
-        std::sqrt(std::max(covariance_(velocity_bias_index_ + k, velocity_bias_index_ + k), 0.0));
+  for (size_t k = 0; k < velocity_bias_axes_.size(); ++k) {
+    const int i = velocity_bias_index_ + static_cast<int>(k);
+    sigma(velocity_bias_axes_[k]) = std::sqrt(std::max(covariance_(i, i), 0.0));
   }
   return sigma;
 }
@@ -247,9 +249,9 @@ void CalibrationFilter::motionModel(const MotionIncrement& motion, Eigen::Isomet
   }
   if (velocity_bias_index_ >= 0) {
     const double h = 1e-3;
-    for (int k = 0; k < kVelocityBiasAxes; ++k) {
-      const Eigen::Vector3d step = h * Eigen::Vector3d::Unit(kVelocityBiasAxis[k]);
-      jacobian->col(velocity_bias_index_ - layout::kOdometry + k) =
+    for (size_t k = 0; k < velocity_bias_axes_.size(); ++k) {
+      const Eigen::Vector3d step = h * Eigen::Vector3d::Unit(velocity_bias_axes_[k]);
+      jacobian->col(velocity_bias_index_ - layout::kOdometry + static_cast<int>(k)) =
           (boxMinus(model(time_offset_, velocity_bias_ + step), *corrected) -
            boxMinus(model(time_offset_, velocity_bias_ - step), *corrected)) /
           (2.0 * h);
@@ -324,10 +326,11 @@ void CalibrationFilter::applyCalibrationDrift(double dt) {
   MatrixXd F = MatrixXd::Identity(persistentDim(), persistentDim());
   if (velocity_bias_index_ >= 0) {
     const double decay = std::exp(-dt / config_.odometry_bias_correlation_time);
-    for (int k = 0; k < kVelocityBiasAxes; ++k) {
-      const int i = velocity_bias_index_ + k;
+    for (size_t k = 0; k < velocity_bias_axes_.size(); ++k) {
+      const int i = velocity_bias_index_ + static_cast<int>(k);
       F(i, i) = decay;
-      drift(i, i) = std::pow(config_.odometry_velocity_bias_sigma, 2) * (1.0 - decay * decay);
+      drift(i, i) = std::pow(velocityBiasPriorSigma(config_, velocity_bias_axes_[k]), 2) *
+                    (1.0 - decay * decay);
     }
     velocity_bias_ *= decay;
   }
@@ -612,8 +615,8 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
     time_offset_ = std::clamp(time_offset_ + dg(time_offset_index_), -config_.max_time_offset,
                               config_.max_time_offset);
   }
-  for (int k = 0; velocity_bias_index_ >= 0 && k < kVelocityBiasAxes; ++k)
-    velocity_bias_(kVelocityBiasAxis[k]) += dg(velocity_bias_index_ + k);
+  for (size_t k = 0; k < velocity_bias_axes_.size(); ++k)
+    velocity_bias_(velocity_bias_axes_[k]) += dg(velocity_bias_index_ + static_cast<int>(k));
   if (shared) {
     marginalizeMotionError(P);
   } else {

@@ -129,9 +129,9 @@ class CalibrationFilter {
   /// (0 when not estimated).
   double timeOffset() const { return time_offset_; }
   double timeOffsetSigma() const { return stateSigma(time_offset_index_); }
-  /// The odometry's velocity error state (FilterConfig::odometry_velocity_bias_sigma; m/s,
-  /// vehicle axes; lateral and vertical only, x stays 0) and its 1 sigmas (0 when not
-  /// estimated).
+  /// The odometry's velocity error state (FilterConfig::odometry_velocity_bias_sigma and
+  /// odometry_forward_velocity_bias_sigma; m/s, vehicle axes; 0 on an axis not estimated) and
+  /// its 1 sigmas (0 when not estimated).
   const Eigen::Vector3d& velocityBias() const { return velocity_bias_; }
   Eigen::Vector3d velocityBiasSigma() const;
   std::vector<PointEstimate> points() const;
@@ -212,8 +212,10 @@ class CalibrationFilter {
   /// kOdometry): how many, and where each is (-1: not estimated).
   int odometry_dim_ = 0;
   int time_offset_index_ = -1;
-  int velocity_bias_index_ = -1;  ///< first of 3
-  double time_offset_ = 0.0;      ///< s, odometry clock minus camera clock
+  int velocity_bias_index_ = -1;  ///< first of velocity_bias_axes_.size()
+  /// The vehicle axes (0 x forward, 1 y, 2 z) whose velocity error is a state, in order.
+  std::vector<int> velocity_bias_axes_;
+  double time_offset_ = 0.0;  ///< s, odometry clock minus camera clock
   Eigen::Vector3d velocity_bias_ = Eigen::Vector3d::Zero();  ///< m/s, vehicle axes
   /// The last accepted motion increments since the last reset, oldest first, at most
   /// kTwistTrendIncrements (twistsAtEnds).
