@@ -5,6 +5,7 @@
 #include <functional>
 #include <optional>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <Eigen/Cholesky>
@@ -209,13 +210,14 @@ TEST(CalibrationFilter, NewPointsInUnitsOfTheBaselineAreAcceptedAsMetricOnes) {
     const auto count = [](const std::vector<bool>& a) {
       return std::count(a.begin(), a.end(), true);
     };
-    std::cout << "baseline sigma " << sigma_baseline << " m: accepted metric " << count(accepted[0])
-              << ", scaled " << count(accepted[1]) << " of 40\n";
-    EXPECT_EQ(accepted[1], accepted[0]) << "baseline sigma " << sigma_baseline;
+    const std::string counts = "baseline sigma " + std::to_string(sigma_baseline) +
+                               " m: accepted metric " + std::to_string(count(accepted[0])) +
+                               ", scaled " + std::to_string(count(accepted[1])) + " of 40";
+    EXPECT_EQ(accepted[1], accepted[0]) << counts;
     if (sigma_baseline < 0.05)
-      EXPECT_EQ(count(accepted[0]), 40);
+      EXPECT_EQ(count(accepted[0]), 40) << counts;
     else
-      EXPECT_LT(count(accepted[0]), 40);  // the check has something to refuse
+      EXPECT_LT(count(accepted[0]), 40) << counts;  // the check has something to refuse
   }
 }
 
