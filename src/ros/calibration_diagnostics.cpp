@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include "online_stereo_calibration/StereoCalibration.h"
@@ -256,6 +257,17 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
     status.add("odometry time offset [ms]", std::to_string(estimate_.time_offset * 1e3) + " +- " +
                                                 std::to_string(estimate_.time_offset_sigma * 1e3) +
                                                 " (odometry clock minus camera clock, 1 sigma)");
+  }
+  // x_camr's drift rate (issue 15), when it is estimated.
+  if (have_estimate_ && estimate_.camr_drift_rate_sigma.maxCoeff() > 0.0) {
+    constexpr double kDegPerMin = 60.0 * 180.0 / M_PI;
+    std::ostringstream rate;
+    rate << std::fixed << std::setprecision(4);
+    for (int k = 0; k < 3; ++k) {
+      rate << (k ? ", " : "") << estimate_.camr_drift_rate(k) * kDegPerMin << " +- "
+           << estimate_.camr_drift_rate_sigma(k) * kDegPerMin;
+    }
+    status.add("x_camr rotation drift rate [deg/min]", rate.str() + " (about x, y, z; 1 sigma)");
   }
   // Quality figures of the last processed pair (issue 16): values only, no level.
   if (have_estimate_ && quality_) {

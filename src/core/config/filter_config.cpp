@@ -146,6 +146,12 @@ const std::vector<ParameterSpec>& filterParameterTable() {
       real("odometry_scale_sigma_percent", &C::odometry_scale_sigma, 1e-2, 0.0, 50.0,
            "1 sigma of the odometry's scale error, which images cannot tell: added to the "
            "reported uncertainty of the translations (0 = the odometry's scale is exact)"),
+      real("camr_rotation_drift_rate_sigma_deg_per_min", &C::camr_rotation_drift_rate_sigma,
+           kDeg / 60.0, 0.0, 1e4,
+           "steady-state 1 sigma per axis of the rate at which x_camr's rotation drifts, "
+           "estimated as a state (0 = not estimated)"),
+      real("camr_drift_rate_correlation_time_s", &C::camr_drift_rate_correlation_time, 1.0, 0.1,
+           1e6, "correlation time of that drift rate (first-order Gauss-Markov)"),
       real("consistency_window_s", &C::consistency_window, 1.0, 0.0, 1e4,
            "window of the per-block score test of the updates' consistency (0 = off, as the "
            "paper; consistency_monitor.h)"),
@@ -247,8 +253,9 @@ FilterConfig paperFilterConfig() {
   config.odometry_scale_sigma = 0.0;          // ... and exact in scale
   config.odometry_velocity_bias_sigma = 0.0;  // ... and without a velocity error
   config.odometry_forward_velocity_bias_sigma = 0.0;
-  config.inverse_depth_points = 0;    // the paper's points are positions
-  config.baseline_scaled_points = 0;  // ... in metres
+  config.camr_rotation_drift_rate_sigma = 0.0;  // ... and a right camera that does not drift
+  config.inverse_depth_points = 0;              // the paper's points are positions
+  config.baseline_scaled_points = 0;            // ... in metres
   return config;
 }
 

@@ -408,6 +408,8 @@ CalibrationEstimate StereoCalibrationEstimator::estimate() const {
   e.consistency = filter_.consistency();
   e.time_offset = filter_.timeOffset();
   e.time_offset_sigma = filter_.timeOffsetSigma();
+  e.camr_drift_rate = filter_.camrDriftRate();
+  e.camr_drift_rate_sigma = filter_.camrDriftRateSigma();
   return e;
 }
 

@@ -121,11 +121,14 @@ struct CalibrationFilter::Prediction {
   MatrixXd covariance;
   double time_offset = 0.0;
   Eigen::Vector3d velocity_bias = Eigen::Vector3d::Zero();
+  Eigen::Vector3d drift_rate = Eigen::Vector3d::Zero();
   std::vector<MotionIncrement> previous_motions;
   std::vector<TrackedPoint> points;
   // Outputs.
   MatrixXd predicted_covariance;
   Eigen::Vector3d predicted_velocity_bias = Eigen::Vector3d::Zero();
+  Eigen::Isometry3d predicted_T_caml_camr;  ///< moved by the drift rate
+  Eigen::Vector3d predicted_drift_rate = Eigen::Vector3d::Zero();
   std::vector<TrackedPoint> predicted_points;
   MatrixXd P;
   std::vector<bool> failed;
@@ -204,6 +207,10 @@ CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoInt
     velocity_bias_index_ = layout::kOdometry + odometry_dim_;
     odometry_dim_ += static_cast<int>(velocity_bias_axes_.size());
   }
+  if (config.camr_rotation_drift_rate_sigma > 0.0) {
+    drift_rate_index_ = layout::kOdometry + odometry_dim_;
+    drift_rate_dim_ = 3;
+  }
   reset(StereoExtrinsics());
 }
 
@@ -216,6 +223,9 @@ MatrixXd CalibrationFilter::startCovariance(const Matrix12d& calibration) const 
     const int i = velocity_bias_index_ + static_cast<int>(k);
     P(i, i) = std::pow(velocityBiasPriorSigma(config_, velocity_bias_axes_[k]), 2);
   }
+  for (int k = 0; k < drift_rate_dim_; ++k)
+    P(drift_rate_index_ + k, drift_rate_index_ + k) =
+        std::pow(config_.camr_rotation_drift_rate_sigma, 2);
   return P;
 }
 
@@ -225,6 +235,12 @@ Eigen::Vector3d CalibrationFilter::velocityBiasSigma() const {
     const int i = velocity_bias_index_ + static_cast<int>(k);
     sigma(velocity_bias_axes_[k]) = std::sqrt(std::max(covariance_(i, i), 0.0));
   }
+  return sigma;
+}
+
+Eigen::Vector3d CalibrationFilter::camrDriftRateSigma() const {
+  Eigen::Vector3d sigma = Eigen::Vector3d::Zero();
+  for (int k = 0; k < drift_rate_dim_; ++k) sigma(k) = stateSigma(drift_rate_index_ + k);
   return sigma;
 }
 
@@ -276,6 +292,7 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& co
   covariance_ = startCovariance(covariance);
   time_offset_ = config_.initial_time_offset;
   velocity_bias_.setZero();
+  drift_rate_.setZero();
   previous_motions_.clear();
   excitation_.reset();
   monitor_.reset();
@@ -333,6 +350,22 @@ void CalibrationFilter::applyCalibrationDrift(double dt) {
                     (1.0 - decay * decay);
     }
     velocity_bias_ *= decay;
+  }
+  if (drift_rate_index_ >= 0) {
+    // x_camr's rotation integrates its drift rate: the nominal turns by w dt, the error by
+    // dw dt (to first order in w dt, boxPlus tangent); the rate is Gauss-Markov.
+    const double decay = std::exp(-dt / config_.camr_drift_rate_correlation_time);
+    const int rotation = layout::kCamr + layout::kRotation;
+    for (int k = 0; k < drift_rate_dim_; ++k) {
+      const int i = drift_rate_index_ + k;
+      F(rotation + k, i) = dt;
+      F(i, i) = decay;
+      drift(i, i) = std::pow(config_.camr_rotation_drift_rate_sigma, 2) * (1.0 - decay * decay);
+    }
+    Vector6d turn = Vector6d::Zero();
+    turn.segment<3>(layout::kRotation) = drift_rate_ * dt;
+    extrinsics_.T_caml_camr = boxPlus(extrinsics_.T_caml_camr, turn);
+    drift_rate_ *= decay;
   }
   const MatrixXd FP = F * covariance_;
   const MatrixXd P_next = FP * F.transpose() + drift;
@@ -450,6 +483,8 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
   const std::vector<TrackedPoint> saved_points = passes > 1 ? points_ : std::vector<TrackedPoint>();
   const MatrixXd saved_covariance = covariance_;
   const Eigen::Vector3d saved_velocity_bias = velocity_bias_;
+  const Eigen::Vector3d saved_drift_rate = drift_rate_;
+  const Eigen::Isometry3d saved_T_caml_camr = extrinsics_.T_caml_camr;
   MotionIncrement linearization = motion;
   Vector6d prior_motion_error = Vector6d::Zero();
   for (int pass = 0; pass < passes; ++pass) {
@@ -457,6 +492,8 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
       points_ = saved_points;
       covariance_ = saved_covariance;
       velocity_bias_ = saved_velocity_bias;
+      drift_rate_ = saved_drift_rate;
+      extrinsics_.T_caml_camr = saved_T_caml_camr;
       report = StepReport();
     }
     Vector6d estimated_motion_error;
@@ -617,6 +654,7 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   }
   for (size_t k = 0; k < velocity_bias_axes_.size(); ++k)
     velocity_bias_(velocity_bias_axes_[k]) += dg(velocity_bias_index_ + static_cast<int>(k));
+  if (drift_rate_index_ >= 0) drift_rate_ += dg.segment<3>(drift_rate_index_);
   if (shared) {
     marginalizeMotionError(P);
   } else {
@@ -649,11 +687,13 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
         last->extrinsics.T_veh_caml.matrix() == extrinsics_.T_veh_caml.matrix() &&
         last->extrinsics.T_caml_camr.matrix() == extrinsics_.T_caml_camr.matrix() &&
         last->covariance == covariance_ && last->time_offset == time_offset_ &&
-        last->velocity_bias == velocity_bias_ &&
+        last->velocity_bias == velocity_bias_ && last->drift_rate == drift_rate_ &&
         samePreviousMotions(last->previous_motions, previous_motions_) &&
         samePoints(last->points, points_)) {
       covariance_ = last->predicted_covariance;
       velocity_bias_ = last->predicted_velocity_bias;
+      drift_rate_ = last->predicted_drift_rate;
+      extrinsics_.T_caml_camr = last->predicted_T_caml_camr;
       points_ = last->predicted_points;
       *failed = last->failed;
       last_prediction_ = last;  // its measurement UTs, for linearizeMeasurement
@@ -668,11 +708,14 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
   prediction->covariance = covariance_;
   prediction->time_offset = time_offset_;
   prediction->velocity_bias = velocity_bias_;
+  prediction->drift_rate = drift_rate_;
   prediction->previous_motions = previous_motions_;
   prediction->points = points_;
   const MatrixXd P = predictAnew(motion, failed);
   prediction->predicted_covariance = covariance_;
   prediction->predicted_velocity_bias = velocity_bias_;
+  prediction->predicted_drift_rate = drift_rate_;
+  prediction->predicted_T_caml_camr = extrinsics_.T_caml_camr;
   prediction->predicted_points = points_;
   prediction->P = P;
   prediction->failed = *failed;

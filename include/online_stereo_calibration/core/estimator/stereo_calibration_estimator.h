@@ -36,6 +36,10 @@ struct CalibrationEstimate {
   /// camera clock (s), and its 1 sigma (0 = not estimated).
   double time_offset = 0.0;
   double time_offset_sigma = 0.0;
+  /// The rate at which x_camr's rotation drifts (CalibrationFilter::camrDriftRate; rad/s,
+  /// boxPlus tangent) and its 1 sigmas (zero = not estimated).
+  Eigen::Vector3d camr_drift_rate = Eigen::Vector3d::Zero();
+  Eigen::Vector3d camr_drift_rate_sigma = Eigen::Vector3d::Zero();
   /// The part of parameter_covariance (and of tangent_covariance) that the odometry's scale
   /// uncertainty adds (FilterConfig::odometry_scale_sigma; zero when 0): convergence.h does
   /// not wait for it.

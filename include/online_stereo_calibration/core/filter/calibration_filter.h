@@ -134,6 +134,10 @@ class CalibrationFilter {
   /// its 1 sigmas (0 when not estimated).
   const Eigen::Vector3d& velocityBias() const { return velocity_bias_; }
   Eigen::Vector3d velocityBiasSigma() const;
+  /// x_camr's rotation drift rate (rad/s, boxPlus tangent; FilterConfig::
+  /// camr_rotation_drift_rate_sigma) and its 1 sigmas (zero when not estimated).
+  const Eigen::Vector3d& camrDriftRate() const { return drift_rate_; }
+  Eigen::Vector3d camrDriftRateSigma() const;
   std::vector<PointEstimate> points() const;
   /// The full (P + 3N)^2 covariance the structured form represents (P = 12 + the odometry
   /// states), points in the order of points() and in the filter's point coordinates
@@ -167,8 +171,9 @@ class CalibrationFilter {
     return config_.baseline_scaled_points != 0 ? T_caml_camr.translation().norm() : 1.0;
   }
   double pointScale() const { return pointScale(extrinsics_.T_caml_camr); }
-  /// Size of the persistent global error: calibration (12) + odometry states.
-  int persistentDim() const { return layout::kCalibrationDim + odometry_dim_; }
+  /// Size of the persistent global error: calibration (12) + odometry states + x_camr's
+  /// drift rate.
+  int persistentDim() const { return layout::kCalibrationDim + odometry_dim_ + drift_rate_dim_; }
   double stateSigma(int index) const {
     return index < 0 ? 0.0 : std::sqrt(std::max(covariance_(index, index), 0.0));
   }
@@ -217,6 +222,11 @@ class CalibrationFilter {
   std::vector<int> velocity_bias_axes_;
   double time_offset_ = 0.0;  ///< s, odometry clock minus camera clock
   Eigen::Vector3d velocity_bias_ = Eigen::Vector3d::Zero();  ///< m/s, vehicle axes
+  /// x_camr's rotation drift rate (FilterConfig::camr_rotation_drift_rate_sigma): 3 states
+  /// after the odometry's, or none.
+  int drift_rate_dim_ = 0;
+  int drift_rate_index_ = -1;
+  Eigen::Vector3d drift_rate_ = Eigen::Vector3d::Zero();  ///< rad/s, tangent of x_camr
   /// The last accepted motion increments since the last reset, oldest first, at most
   /// kTwistTrendIncrements (twistsAtEnds).
   std::vector<MotionIncrement> previous_motions_;
