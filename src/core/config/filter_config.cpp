@@ -108,6 +108,11 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "fraction of gated-out points that signals a sudden calibration change"),
       integer("jump_min_points", &C::jump_min_points, 1, 100000,
               "least number of tested points for the jump test"),
+      real("jump_sustained_rejected_fraction", &C::jump_sustained_rejected_fraction, 1.0, 0.0, 1.0,
+           "a smaller fraction of gated-out points that signals a sudden calibration change "
+           "when it holds jump_sustained_frames frames in a row"),
+      integer("jump_sustained_frames", &C::jump_sustained_frames, 0, 100000,
+              "frames in a row for that (0 = off)"),
       real("jump_rotation_sigma_deg", &C::jump_rotation_sigma, kDeg, 0.0, 90.0,
            "rotation 1 sigma re-opened after a detected jump"),
       real("jump_translation_sigma_m", &C::jump_translation_sigma, 1.0, 0.0, 10.0,

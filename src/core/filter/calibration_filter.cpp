@@ -297,6 +297,7 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& co
   excitation_.reset();
   monitor_.reset();
   time_since_opened_ = {0.0, 0.0};
+  rejection_streak_ = 0;
   points_.clear();
   index_.clear();
 }
@@ -573,9 +574,22 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   const JumpBlock suspect = 2 * left_failures >= static_cast<int>(report.outliers.size())
                                 ? JumpBlock::kVehicleToLeft
                                 : JumpBlock::kLeftToRight;
-  if (detect_jump && tested >= config_.jump_min_points &&
-      report.outliers.size() >= config_.jump_rejected_fraction * tested && canReopen(suspect)) {
+  const double rejected = static_cast<double>(report.outliers.size());
+  const bool enough_tested = tested >= config_.jump_min_points;
+  if (detect_jump) {
+    const bool partly =
+        enough_tested && rejected >= config_.jump_sustained_rejected_fraction * tested;
+    rejection_streak_ = partly ? rejection_streak_ + 1 : 0;
+  }
+  // Not while the suspect block is still settling: a start-up transient gates out many
+  // points for some frames too (default campaign run 180 re-opened x_camr at frame 32).
+  const bool sustained = config_.jump_sustained_frames > 0 &&
+                         rejection_streak_ >= config_.jump_sustained_frames &&
+                         time_since_opened_[blockIndex(suspect)] >= config_.jump_settle_time;
+  if (detect_jump && enough_tested &&
+      (rejected >= config_.jump_rejected_fraction * tested || sustained) && canReopen(suspect)) {
     report.jump = suspect;
+    rejection_streak_ = 0;
     if (shared) marginalizeMotionError(P);
     reopenBlock(report.jump);
     report.lost.reserve(points_.size());

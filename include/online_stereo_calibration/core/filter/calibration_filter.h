@@ -234,6 +234,8 @@ class CalibrationFilter {
   /// s of accepted motion since each block (x_caml, x_camr) was started or widened
   /// (canReopen).
   std::array<double, 2> time_since_opened_ = {0.0, 0.0};
+  /// Frames in a row with at least jump_sustained_rejected_fraction of the points gated out.
+  int rejection_streak_ = 0;
   PointCoordinates coordinates_;  ///< how TrackedPoint::mean stores a point
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;
