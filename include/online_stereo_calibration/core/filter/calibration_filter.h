@@ -140,8 +140,8 @@ class CalibrationFilter {
   Eigen::Vector3d camrDriftRateSigma() const;
   std::vector<PointEstimate> points() const;
   /// The full (P + 3N)^2 covariance the structured form represents (P = 12 + the odometry
-  /// states), points in the order of points() and in the filter's point coordinates
-  /// (FilterConfig::inverse_depth_points, in units of the baseline with
+  /// states + x_camr's drift rate), points in the order of points() and in the filter's point
+  /// coordinates (FilterConfig::inverse_depth_points, in units of the baseline with
   /// FilterConfig::baseline_scaled_points). For tests and diagnostics; O(N^2).
   Eigen::MatrixXd denseCovariance() const;
 
@@ -240,7 +240,8 @@ class CalibrationFilter {
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;
   StereoExtrinsics extrinsics_;
-  /// Covariance of the persistent global error [calibration (12), odometry states].
+  /// Covariance of the persistent global error [calibration (12), odometry states, x_camr's
+  /// drift rate].
   Eigen::MatrixXd covariance_;
   std::vector<TrackedPoint> points_;
   std::unordered_map<PointId, size_t> index_;
