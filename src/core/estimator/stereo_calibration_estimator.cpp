@@ -57,6 +57,12 @@ void StereoCalibrationEstimator::anchorHere(JumpBlock block, double translation_
   anchor_.rotation_sigma = rotation_sigma;
 }
 
+void StereoCalibrationEstimator::anchorReopening(JumpBlock block, double translation_sigma,
+                                                 double rotation_sigma) {
+  const bool start_is_live = anchorIsLive() && anchor_.blocks[0] && anchor_.blocks[1];
+  if (!start_is_live) anchorHere(block, translation_sigma, rotation_sigma);
+}
+
 double StereoCalibrationEstimator::movedSinceAnchor(int block) const {
   if (!anchor_.blocks[static_cast<size_t>(block)]) return 0.0;
   const StereoExtrinsics& now = filter_.extrinsics();
@@ -254,11 +260,8 @@ FrameReport StereoCalibrationEstimator::processFrame(
       if (report.step.jump != JumpBlock::kNone) {
         report.warnings.push_back(report.step.message);
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());
-        // A jump found while a start is still being re-linearised is part of that start
-        // (a guess far off gates many points out): the start's anchor covers both blocks.
-        if (!anchorIsLive()) {
-          anchorHere(report.step.jump, config_.jump_translation_sigma, config_.jump_rotation_sigma);
-        }
+        anchorReopening(report.step.jump, config_.jump_translation_sigma,
+                        config_.jump_rotation_sigma);
       } else if (relinearizeIfMoved(&report)) {
         // Tracking starts afresh with the next pair, as after a start.
         candidates.clear();
@@ -317,7 +320,7 @@ std::vector<PointId> StereoCalibrationEstimator::resetTracking() {
 std::vector<PointId> StereoCalibrationEstimator::reopenRightCameraRotation(double rotation_sigma) {
   has_previous_frame_ = false;
   std::vector<PointId> dropped = filter_.reopen(JumpBlock::kLeftToRight, 0.0, rotation_sigma);
-  anchorHere(JumpBlock::kLeftToRight, 0.0, rotation_sigma);
+  anchorReopening(JumpBlock::kLeftToRight, 0.0, rotation_sigma);
   return dropped;
 }
 
@@ -349,8 +352,8 @@ std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
   if (start) {
     anchorHere(JumpBlock::kNone, 0.0, 0.0);
   } else {
-    anchorHere(JumpBlock::kLeftToRight, std::sqrt(covariance.diagonal().head<3>().maxCoeff()),
-               std::sqrt(covariance.diagonal().tail<3>().maxCoeff()));
+    anchorReopening(JumpBlock::kLeftToRight, std::sqrt(covariance.diagonal().head<3>().maxCoeff()),
+                    std::sqrt(covariance.diagonal().tail<3>().maxCoeff()));
   }
   return dropped;
 }

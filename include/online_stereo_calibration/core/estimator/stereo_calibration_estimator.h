@@ -153,6 +153,11 @@ class StereoCalibrationEstimator {
   Matrix12d odometryScaleCovariance(const StereoExtrinsics& extrinsics) const;
   /// Anchors at the filter's state now (after a start or re-opening of @p block).
   void anchorHere(JumpBlock block, double translation_sigma, double rotation_sigma);
+  /// anchorHere after a re-opening of @p block, unless a start's anchor is still live: a
+  /// re-opening while a start is still being re-linearised is part of that start (a guess far
+  /// off gates many points out, or moves the pairs off x_camr's epipolar band), and the
+  /// start's anchor covers both blocks.
+  void anchorReopening(JumpBlock block, double translation_sigma, double rotation_sigma);
   /// Largest move since the anchor of a tangent component of @p block (0 x_caml, 1 x_camr)
   /// that the anchor checks (all after a start, the re-opened ones after a re-opening), in
   /// the anchor's 1 sigmas; 0 for a block the anchor does not check.

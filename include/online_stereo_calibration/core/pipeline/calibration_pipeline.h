@@ -43,9 +43,10 @@ struct PipelineResult {
   /// candidates; raw pixels), e.g. for the rectification error (live_rectification.h).
   std::vector<StereoObservation> stereo_pairs;
   CalibrationEstimate estimate;  ///< the estimate after this pair
-  /// A knocked right camera: no stereo pair found in this and the previous pair although
-  /// both images had features and the whole-image fits of both contradict x_camr, or the
-  /// refined pairs of both off their epipolar lines by far more than x_camr's sigma allows.
+  /// A knocked right camera: (almost) no stereo pair tracked into this pair although both
+  /// images had features and the pair's whole-image fit contradicts x_camr, or the
+  /// refined pairs of this and the previous pair off their epipolar lines by far more than
+  /// x_camr's sigma allows.
   /// x_camr's rotation was re-opened and tracking restarted.
   bool right_camera_reopened = false;
   /// The whole-image stereo fit at a start was tried in this pair
@@ -109,14 +110,15 @@ class CalibrationPipeline {
   /// Arms the stereo fit for the next pairs (FilterConfig::stereo_fit_*): after a start, or
   /// @p after_reopening of x_camr's rotation.
   void armStereoFit(bool after_reopening);
-  /// Counts pairs in which no stereo pair was found although both images had features; true
-  /// (a knocked right camera) from the second in a row.
-  bool lostTheStereoGeometry(const FrontEndStatistics& stats);
+  /// True for a pair into which (almost) no stereo pair was tracked although both images had
+  /// features: a knocked right camera, or a view without usable texture (the whole-image fit
+  /// tells).
+  bool lostTheStereoGeometry(const FrontEndStatistics& stats) const;
   /// After lostTheStereoGeometry: fits the pair's epipolar geometry over the whole images
   /// (fitStereoGeometry) and counts fits whose rotation across the epipolar lines (about the
   /// optical x and z axes) is more than kKnockSigmas combined sigmas (and 0.05 deg) from
-  /// x_camr's; true from the second in a row, with 3 times that angle as the rotation sigma
-  /// to re-open with. @p status says what was seen.
+  /// x_camr's; true for such a fit, with 3 times that angle as the rotation sigma to re-open
+  /// with. @p status says what was seen.
   bool wholeImageFitContradicts(double* rotation_sigma, std::string* status);
   /// Counts pairs whose refined pairs lie off their epipolar lines (EpipolarTrend) by an angle
   /// of more than kKnockSigmas x_camr rotation sigmas; true from the second in a row, with
@@ -125,8 +127,6 @@ class CalibrationPipeline {
 
   std::unique_ptr<StereoCalibrationEstimator> estimator_;
   std::unique_ptr<StereoFrontEnd> front_end_;
-  /// Consecutive processed pairs without a stereo pair although both images had features.
-  int pairs_without_stereo_ = 0;
   /// Consecutive processed pairs whose refined pairs lay off their lines (rightCameraMoved).
   int pairs_off_their_lines_ = 0;
   /// Consecutive whole-image fits contradicting x_camr (wholeImageFitContradicts).
