@@ -101,7 +101,7 @@ struct StartRun {
 };
 
 StartRun runStart(const Vector12d& initial_error, int frames, int stereo_fit_start,
-                  unsigned seed = 1) {
+                  unsigned seed = 1, const FrontEndConfig& front_end = FrontEndConfig()) {
   MeasurementScenario scenario = paperOffroadScenario();
   scenario.seed = seed;
   scenario.frames = frames;
@@ -111,7 +111,7 @@ StartRun runStart(const Vector12d& initial_error, int frames, int stereo_fit_sta
   config.stereo_fit_start = stereo_fit_start;
   StartRun run;
   runImageScenario(
-      scenario, config, FrontEndConfig(), {},
+      scenario, config, front_end, {},
       [&](const ImageFrameResult& r, const CalibrationPipeline&) {
         if (r.stereo_fit && r.stereo_fit->valid) {
           ++run.fits;
@@ -165,6 +165,29 @@ TEST(StereoFitStart, RightCameraFiveDegreesOffIsReseededFromTheFirstPair) {
   const StartRun good = runStart(paperOffroadScenario().initial_error, 3, 1);
   EXPECT_EQ(good.fits, 1);
   EXPECT_EQ(good.reseeded_at, -1);
+}
+
+// x_camr's pitch 4.6 deg off (2.3 of the 2 deg start sigma, and the fit 2.3 combined sigmas
+// away, below stereo_fit_restart_distance) beyond the band's 60 px cap (max_band): the guess's
+// epipolar band holds (almost) no match, so the fit, the only evidence there is, re-seeds
+// x_camr all the same. Before, the start kept the guess (image run 1 of session 14's
+// campaign, 975 px focal length, where the cap is 3.5 deg: 1-4 stereo pairs per pair for 60
+// pairs, x_caml unlearned, and after a later knock yr 30 sigma off). The paper drive's 600 px
+// focal length puts the cap at 5.7 deg, beyond the restart distance; a cap of 30 px (2.9 deg)
+// stands for the longer lens.
+TEST(StereoFitStart, RightCameraWhoseBandHoldsNoMatchIsReseededThoughWithinItsSigma) {
+  Vector12d error = paperOffroadScenario().initial_error;
+  error.tail<3>() << 0.0, 4.6 * kDeg, 0.0;
+  FrontEndConfig long_lens;
+  long_lens.max_band = 30.0;
+  const StartRun run = runStart(error, 60, 1, 1, long_lens);
+  std::cout << "pitch_r 4.6 deg off: re-seeded at frame " << run.reseeded_at
+            << "; from frame 30 all 12 within 3 sigma in " << run.within << " of " << run.frames
+            << ", worst " << run.worst << "\n";
+  EXPECT_EQ(run.reseeded_at, 0);
+  EXPECT_LT(run.last_rotation_error, 0.05 * kDeg);
+  EXPECT_GE(run.within, 0.95 * run.frames);
+  EXPECT_EQ(run.beyond, 0) << "worst " << run.worst;
 }
 
 // The figures of docs/RESULTS.md "Stereo fit at start": image-level starts with x_camr's

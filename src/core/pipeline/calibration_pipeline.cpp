@@ -23,6 +23,8 @@ constexpr int kKnockedPairsBeforeReopening = 2;
 /// second pair kept the knock's own pair 50-180 sigma off (images campaign runs 2, 4, 8, 17 of
 /// session 13).
 constexpr int kContradictingFitsBeforeReopening = 1;
+/// Stereo pairs (tracked, or matched in the epipolar band) in a pair that count as "none".
+constexpr int kNoPairs = 5;
 
 }  // namespace
 
@@ -71,7 +73,7 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   std::string seeded;
   if (stereo_fit_attempts_left_ > 0) {
     result.stereo_fit_tried = true;
-    if (seedRightRotationFromFit(&seeded)) {
+    if (seedRightRotationFromFit(result.front_end, &seeded)) {
       // The pairs were matched in the epipolar band of the old rotation: again in the fit's.
       front_end_->reset();
       result.stereo_pairs = front_end_->observe(left_mono, right_mono, motion_since_last_processed,
@@ -146,13 +148,12 @@ void CalibrationPipeline::feedHandEye(const MotionIncrement& motion) {
 
 bool CalibrationPipeline::lostTheStereoGeometry(const FrontEndStatistics& stats) const {
   constexpr int kMinFeatures = 200;  // per image: enough texture to expect pairs
-  constexpr int kMaxPairs = 5;       // tracked stereo pairs: "none"
   const bool textured = stats.features_left >= kMinFeatures && stats.features_right >= kMinFeatures;
   // Counted are the pairs tracked into this one, not the new matches: after a knock the
   // epipolar band of the old x_camr still holds a few dozen chance matches per pair, but none
   // of them is found again in the next pair (image run 1 of session 13: 20-47 matches and 0
   // tracked for 130 pairs, the filter without a single update). The whole-image fit decides.
-  const bool none = stats.tracked <= kMaxPairs;
+  const bool none = stats.tracked <= kNoPairs;
   return textured && none;
 }
 
@@ -208,7 +209,8 @@ bool CalibrationPipeline::wholeImageFitContradicts(double* rotation_sigma, std::
   return fits_contradicting_ >= kContradictingFitsBeforeReopening;
 }
 
-bool CalibrationPipeline::seedRightRotationFromFit(std::string* message) {
+bool CalibrationPipeline::seedRightRotationFromFit(const FrontEndStatistics& stats,
+                                                   std::string* message) {
   const StereoExtrinsics estimate = estimator_->filter().extrinsics();
   const Eigen::Isometry3d T_lopt_ropt = estimate.leftToRightOptical();
   const Matrix12d covariance = estimator_->filter().covariance();
@@ -225,7 +227,13 @@ bool CalibrationPipeline::seedRightRotationFromFit(std::string* message) {
   stereo_fit_attempts_left_ = 0;  // one valid fit per start
   const bool after_reopening = stereo_fit_after_reopening_;
   stereo_fit_after_reopening_ = false;
-  if (!after_reopening && !(last_seed_.distance > filter_config_.stereo_fit_restart_distance)) {
+  // Within the guess's uncertainty the fit adds little, unless the guess's epipolar band held
+  // (almost) no match: then the fit is the only evidence of x_camr there is (image run 1 of
+  // session 14: pitch_r guessed 4.6 deg off at 1 sigma 2 deg, the fit 2.5 sigmas away, and
+  // 1-4 matches per pair for 60 pairs).
+  const bool band_empty = stats.tracked + stats.stereo_matches <= kNoPairs;
+  if (!after_reopening && !band_empty &&
+      !(last_seed_.distance > filter_config_.stereo_fit_restart_distance)) {
     return false;
   }
   const Eigen::Vector3d before = rpyFromRotation(estimate.T_caml_camr.linear()) * 180.0 / M_PI;

@@ -103,10 +103,11 @@ class CalibrationPipeline {
   void restartFrontEnd();
   /// The stereo fit at a start or after a re-opening of x_camr's rotation
   /// (FilterConfig::stereo_fit_start): fits the last pair over the whole images and, if
-  /// x_camr's rotation is farther from the fit's than stereo_fit_restart_distance (after a
-  /// re-opening: always), re-seeds x_camr from the fit (rightRotationSeed). True if it did;
-  /// @p message then says what changed. A valid fit ends the attempts.
-  bool seedRightRotationFromFit(std::string* message);
+  /// x_camr's rotation is farther from the fit's than stereo_fit_restart_distance, or its
+  /// epipolar band held (almost) no stereo match in that pair (@p stats; after a re-opening:
+  /// always), re-seeds x_camr from the fit (rightRotationSeed). True if it did; @p message
+  /// then says what changed. A valid fit ends the attempts.
+  bool seedRightRotationFromFit(const FrontEndStatistics& stats, std::string* message);
   /// Arms the stereo fit for the next pairs (FilterConfig::stereo_fit_*): after a start, or
   /// @p after_reopening of x_camr's rotation.
   void armStereoFit(bool after_reopening);
