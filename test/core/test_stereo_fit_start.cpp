@@ -111,8 +111,7 @@ StartRun runStart(const Vector12d& initial_error, int frames, int stereo_fit_sta
   config.stereo_fit_start = stereo_fit_start;
   StartRun run;
   runImageScenario(
-      scenario, config, front_end, {},
-      [&](const ImageFrameResult& r, const CalibrationPipeline&) {
+      scenario, config, front_end, {}, [&](const ImageFrameResult& r, const CalibrationPipeline&) {
         if (r.stereo_fit && r.stereo_fit->valid) {
           ++run.fits;
           const Eigen::Matrix3d R_true =
