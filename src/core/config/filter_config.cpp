@@ -195,7 +195,7 @@ const std::vector<ParameterSpec>& filterParameterTable() {
               "(image level) and re-seed it from the fit if the estimate disagrees; 0: off"),
       real("stereo_fit_restart_distance", &C::stereo_fit_restart_distance, 1.0, 0.0, 1e6,
            "re-seed x_camr's rotation when it is farther from the fit's than this Mahalanobis "
-           "distance (3 dof)"),
+           "distance (3 dof), or when its epipolar band held (almost) no match"),
       real("stereo_fit_min_sigma_deg", &C::stereo_fit_min_sigma, kDeg, 0.0, 90.0,
            "1 sigma added in quadrature per axis to the fit's rotation"),
       real("stereo_fit_min_sigma_along_lines_deg", &C::stereo_fit_min_sigma_along_lines, kDeg, 0.0,

@@ -243,7 +243,7 @@ struct FilterConfig {
   /// from it with the fit's covariance; 0: off (the paper).
   int stereo_fit_start = 1;
   /// Re-seed when x_camr's rotation is farther from the fit's than this Mahalanobis distance
-  /// (both covariances, 3 dof).
+  /// (both covariances, 3 dof), or when its epipolar band held (almost) no stereo match.
   double stereo_fit_restart_distance = 3.0;
   /// rad: added in quadrature per axis to the fit's rotation 1 sigma (its own, from the
   /// inliers' spread, ignores keypoint biases and a lens model's residual).
