@@ -284,10 +284,10 @@ Scored score(const MeasurementScenario& s, const FilterConfig& config, int first
 
 // Issue 14: a camera mounted backwards or sideways, guessed as a forward one (identity
 // rotation, the windscreen's translation): the hand-eye start restarts the filter with the
-// rotation of the motion within 30 frames, and from frame 50 on (the restart, at frame 10-20,
-// plus the 30 frames a normal start is given) every parameter is within 3 sigma in >= 90 % (95 % in
-// two of three) of the frames and never beyond 5 sigma. Without it the filter ends 60-100 sigma
-// off.
+// rotation of the motion within 30 frames (the backward one; see below for the sideways
+// ones), and from frame 50 on (the restart, at frame 10-20, plus the 30 frames a normal start
+// is given) every parameter is within 3 sigma in >= 95 % of the frames and never beyond 5
+// sigma. Without it the backward camera is never found.
 TEST(HandEyeStart, BackwardAndSidewaysCamerasGuessedForwardConverge) {
   for (const Vector6d& mounting : {kBackward, kLeft, kRight}) {
     if (getenv("OSC_HAND_EYE_ONLY") != nullptr &&
@@ -307,14 +307,22 @@ TEST(HandEyeStart, BackwardAndSidewaysCamerasGuessedForwardConverge) {
               << " of " << s.frames << " frames, beyond 5 sigma in " << s.beyond_5sigma
               << ", worst " << s.worst << " (tangent parameter " << s.worst_parameter
               << " at frame " << s.worst_frame << ")\n";
-    EXPECT_EQ(s.restarts, 1) << "yaw " << mounting(5);
-    EXPECT_GT(s.restart_frame, 0);
-    EXPECT_LT(s.restart_frame, 30);
-    EXPECT_LT(s.rotation_error_at_restart, 5.0 * kDeg);
-    // Measured with inverse-depth points: 249 / 232 / 250 of 250 (backward, left, right; the
-    // left one has yaw_r 3-3.5 sigma off in frames 47-62, the settling after the restart:
-    // issue 14's "no collapse on thin evidence" is open), so 90 % here, not the issue's 95 %.
-    EXPECT_GE(s.all_within_3sigma, 0.9 * s.frames) << "yaw " << mounting(5);
+    // 180 deg off is beyond what the filter's updates can turn: the hand-eye restart finds
+    // it. A sideways camera 90 deg off was restarted too until the first updates were
+    // tempered (max_sigma_shrink_per_update); since then the filter turns to it on its own
+    // (no restart; the hand-eye's estimate then agrees with the filter's).
+    if (mounting == kBackward) {
+      EXPECT_EQ(s.restarts, 1) << "yaw " << mounting(5);
+      EXPECT_GT(s.restart_frame, 0);
+      EXPECT_LT(s.restart_frame, 30);
+      EXPECT_LT(s.rotation_error_at_restart, 5.0 * kDeg);
+    } else {
+      EXPECT_LE(s.restarts, 1) << "yaw " << mounting(5);
+    }
+    // Measured with inverse-depth points and tempered updates: 250 of 250 each (backward,
+    // left, right; untempered 249 / 232 / 250, the left one with yaw_r 3-3.5 sigma off in
+    // frames 47-62, the settling after the restart).
+    EXPECT_GE(s.all_within_3sigma, 0.95 * s.frames) << "yaw " << mounting(5);
     EXPECT_EQ(s.beyond_5sigma, 0) << "yaw " << mounting(5) << " worst " << s.worst;
   }
   // Off, the backward camera is never found.

@@ -131,6 +131,10 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "this (1 = as expected)"),
       integer("max_relinearizations", &C::max_relinearizations, 0, 1000,
               "restarts at most after one start or re-opening"),
+      real("max_sigma_shrink_per_update", &C::max_sigma_shrink_per_update, 1.0, 0.0, 1e6,
+           "largest factor by which one update may shrink a calibration sigma; a larger "
+           "shrink (a start or re-opening far off) is tempered and spread over frames; "
+           "0 = off"),
       real("initial_time_offset_ms", &C::initial_time_offset, 1e-3, -1000.0, 1000.0,
            "prior mean of the odometry clock minus the camera clock"),
       real("initial_time_offset_sigma_ms", &C::initial_time_offset_sigma, 1e-3, 0.0, 1000.0,
@@ -225,6 +229,12 @@ std::vector<std::string> FilterConfig::validate() const {
             << " must lie within +- max_time_offset_ms = " << max_time_offset * 1e3;
     problems.push_back(message.str());
   }
+  if (max_sigma_shrink_per_update > 0.0 && max_sigma_shrink_per_update <= 1.0) {
+    std::ostringstream message;
+    message << "max_sigma_shrink_per_update = " << max_sigma_shrink_per_update
+            << " must be 0 (off) or above 1 (a factor by which a sigma may shrink)";
+    problems.push_back(message.str());
+  }
   if (min_point_depth >= max_point_depth) {
     std::ostringstream message;
     message << "min_point_depth_m = " << min_point_depth
@@ -254,6 +264,7 @@ FilterConfig paperFilterConfig() {
   config.motion_excitation_window = 0.0;      // the paper linearises at the measured motion
   config.consistency_window = 0.0;            // the paper's random walk is fixed
   config.relinearization_frames = 0;          // the paper's filter runs on from its start
+  config.max_sigma_shrink_per_update = 0.0;   // ... and updates as the UKF does
   config.initial_time_offset_sigma = 0.0;     // the paper takes the odometry as synchronised
   config.odometry_scale_sigma = 0.0;          // ... and exact in scale
   config.odometry_velocity_bias_sigma = 0.0;  // ... and without a velocity error

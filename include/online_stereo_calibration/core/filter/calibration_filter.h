@@ -74,6 +74,9 @@ struct StepReport {
   JumpBlock jump = JumpBlock::kNone;  ///< a sudden calibration change was detected
   bool covariance_repaired = false;   ///< the calibration covariance had to be made PD
   double mean_nis = 0.0;              ///< mean normalised innovation squared of used points (4 dof)
+  /// >= 1: the factor the update's measurement covariances were multiplied by so that no
+  /// calibration sigma shrank by more than max_sigma_shrink_per_update (update_tempering.h).
+  double tempering = 1.0;
   /// The consistency monitor after this step (per-block window statistics, bounds, the
   /// drift-noise factors it set; consistency_monitor.h).
   ConsistencyStatus consistency;
