@@ -93,6 +93,7 @@ FilterConfig configOfTheDenseReference() {
   config.odometry_forward_velocity_bias_sigma = 0.0;
   config.inverse_depth_points = 0;
   config.baseline_scaled_points = 0;
+  config.max_sigma_shrink_per_update = 0.0;  // it updates as the plain UKF does
   return config;
 }
 
@@ -225,6 +226,37 @@ TEST(UpdateTempering, CorrelatedStatesOfManyPointsStayNearTheBound) {
   EXPECT_GT(largest, 3.0 * 0.9);
   const Eigen::MatrixXd untempered = temperedPosterior(P, J, S0, 1.0);
   EXPECT_GT(std::sqrt(P(0, 0) / untempered(0, 0)), 30.0);  // what it prevents
+}
+
+// The filter applies the tempering: from a wide prior, 40 points shrink some calibration
+// sigma far more than threefold in the first update; with max_sigma_shrink_per_update 3
+// none shrinks by more (a little above for correlated states), and the step says by how
+// much the update was tempered.
+TEST(CalibrationFilter, FirstUpdateFromAWidePriorShrinksNoSigmaBeyondTheBound) {
+  const auto largest_shrink = [](double max_shrink, double* tempering) {
+    SmallProblem problem(40, 2);
+    FilterConfig config;
+    config.max_sigma_shrink_per_update = max_shrink;
+    CalibrationFilter filter(config, problem.K);
+    filter.reset(problem.guess, guessCovariance(5.0));
+    const Matrix12d before = filter.covariance();
+    for (const PointMeasurement& m : problem.measure(0, 0.3)) filter.addPoint(m);
+    const StepReport report = filter.step(problem.motion(1), problem.measure(1, 0.3));
+    EXPECT_TRUE(report.accepted);
+    *tempering = report.tempering;
+    const Matrix12d after = filter.covariance();
+    double largest = 0.0;
+    for (int k = 0; k < 12; ++k) largest = std::max(largest, std::sqrt(before(k, k) / after(k, k)));
+    return largest;
+  };
+  double tempering = 0.0, untempered_factor = 0.0;
+  const double tempered = largest_shrink(3.0, &tempering);
+  const double untempered = largest_shrink(0.0, &untempered_factor);
+  EXPECT_GT(untempered, 5.0);
+  EXPECT_EQ(untempered_factor, 1.0);
+  EXPECT_LT(tempered, 3.0 * 1.1);
+  EXPECT_GT(tempered, 2.0);
+  EXPECT_GT(tempering, 1.0);
 }
 
 // A standing rig re-looking at static points learns nothing about its baseline's length: a
