@@ -94,6 +94,14 @@ void BM_StructuredFilterStepWithPositions(benchmark::State& state) {
   structuredFilterStep(state, config);
 }
 
+/// The same without tempering (max_sigma_shrink_per_update 0): what the check whether an
+/// update would shrink a sigma too far costs (it runs the update's covariance part once more).
+void BM_StructuredFilterStepUntempered(benchmark::State& state) {
+  FilterConfig config;
+  config.max_sigma_shrink_per_update = 0.0;
+  structuredFilterStep(state, config);
+}
+
 void BM_DenseUkfStep(benchmark::State& state) {
   const BenchmarkProblem problem(static_cast<int>(state.range(0)));
   DenseCalibrationUkf prepared(FilterConfig(), problem.K);
@@ -119,6 +127,11 @@ BENCHMARK(BM_StructuredFilterStep)
     ->Arg(400)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StructuredFilterStepWithoutMonitor)
+    ->Arg(25)
+    ->Arg(100)
+    ->Arg(400)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StructuredFilterStepUntempered)
     ->Arg(25)
     ->Arg(100)
     ->Arg(400)
