@@ -628,18 +628,13 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   MatrixXd information = monitored ? MatrixXd::Zero(G, G) : MatrixXd();
   VectorXd score = monitored ? VectorXd::Zero(G) : VectorXd();
   double residual_norm = 0.0;
-  for (const PointInnovation* inn : used) {
-    const MatrixXd PJt = P * inn->J.transpose();
-    const Eigen::Matrix4d S = inn->J * PJt + tempering * inn->S0;
-    // Rounding over many sequential updates from a wide prior can leave S indefinite; such
-    // a point must not turn the whole state into NaN (it is skipped, its own update below
-    // uses S0 only).
-    const Eigen::LLT<Eigen::Matrix4d> S_llt(S);
-    if (S_llt.info() != Eigen::Success || !S.allFinite()) continue;
-    const MatrixXd K = S_llt.solve(PJt.transpose()).transpose();
-    if (!K.allFinite()) continue;
-    dg += K * (inn->residual - inn->J * dg);
-    P.noalias() -= K * PJt.transpose();
+  MatrixXd PJt, gain;
+  for (size_t k = 0; k < used.size(); ++k) {
+    const PointInnovation* inn = used[k];
+    // A point whose S is indefinite is skipped here; its own update below uses S0 only.
+    if (!sequentialGain(P, linearized[k], tempering, &PJt, &gain)) continue;
+    dg += gain * (inn->residual - inn->J * dg);
+    P.noalias() -= gain * PJt.transpose();
     nis_sum += inn->nis;
     if (monitored) {
       const Eigen::Matrix4d S0_inverse = inn->S0.inverse();

@@ -2,26 +2,35 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <Eigen/Cholesky>
 
 namespace osc {
+
+bool sequentialGain(const Eigen::MatrixXd& P, const LinearizedMeasurement& measurement,
+                    double alpha, Eigen::MatrixXd* PJt, Eigen::MatrixXd* K) {
+  Eigen::MatrixXd cross = P * measurement.J->transpose();
+  const Eigen::Matrix4d S = *measurement.J * cross + alpha * *measurement.S0;
+  const Eigen::LLT<Eigen::Matrix4d> S_llt(S);
+  if (S_llt.info() != Eigen::Success || !S.allFinite()) return false;
+  Eigen::MatrixXd gain = S_llt.solve(cross.transpose()).transpose();
+  if (!gain.allFinite()) return false;
+  *PJt = std::move(cross);
+  *K = std::move(gain);
+  return true;
+}
+
 namespace {
 
-/// P after the sequential updates with S0 scaled by @p alpha (as CalibrationFilter::runPass
-/// applies them; a measurement whose S is not positive definite is skipped there too).
+/// P after the filter's sequential updates with S0 scaled by @p alpha.
 Eigen::MatrixXd updatedCovariance(const Eigen::MatrixXd& P,
                                   const std::vector<LinearizedMeasurement>& measurements,
                                   double alpha) {
   Eigen::MatrixXd Q = P;
+  Eigen::MatrixXd QJt, K;
   for (const LinearizedMeasurement& m : measurements) {
-    const Eigen::MatrixXd QJt = Q * m.J->transpose();
-    const Eigen::Matrix4d S = *m.J * QJt + alpha * *m.S0;
-    const Eigen::LLT<Eigen::Matrix4d> S_llt(S);
-    if (S_llt.info() != Eigen::Success || !S.allFinite()) continue;
-    const Eigen::MatrixXd K = S_llt.solve(QJt.transpose()).transpose();
-    if (!K.allFinite()) continue;
-    Q.noalias() -= K * QJt.transpose();
+    if (sequentialGain(Q, m, alpha, &QJt, &K)) Q.noalias() -= K * QJt.transpose();
   }
   return Q;
 }

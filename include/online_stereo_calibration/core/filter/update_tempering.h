@@ -27,6 +27,14 @@ struct LinearizedMeasurement {
   const Eigen::Matrix4d* S0 = nullptr;  ///< 4 x 4
 };
 
+/// One step of the filter's sequential update (CalibrationFilter::runPass): @p PJt = P J^T
+/// and the gain @p K = P J^T S^-1 with S = J P J^T + alpha S0. False, with nothing set, when
+/// S is not positive definite or K not finite (rounding over many sequential updates from a
+/// wide prior can leave S indefinite; the filter skips such a point rather than turn the whole
+/// state into NaN).
+bool sequentialGain(const Eigen::MatrixXd& P, const LinearizedMeasurement& measurement,
+                    double alpha, Eigen::MatrixXd* PJt, Eigen::MatrixXd* K);
+
 /// The factor alpha >= 1 for S0 such that the update of prior covariance @p P with
 /// @p measurements shrinks none of the first @p limited standard deviations by more than
 /// @p max_shrink (the sequential update the filter applies, S = J P J^T + alpha S0). 1 when
