@@ -88,6 +88,61 @@ TEST(TimeOffset, ConstantTwistIsNotCorrected) {
   EXPECT_LT((logSE3(m.T_prev_curr) - twist * m.dt).norm(), 1e-12);
 }
 
+/// A carried rig's sway: roll, pitch and yaw oscillate at 1-2 Hz, so the twist changes fast
+/// and its rate too (the first-order offset model's error is in that change).
+Eigen::Isometry3d swayingPose(double t) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotationFromRpy(Eigen::Vector3d(
+      0.05 * std::sin(9.4 * t), 0.08 * std::sin(6.3 * t + 1.0), 0.3 * std::sin(4.1 * t) + 0.2 * t));
+  pose.translation() = Eigen::Vector3d(1.4 * t, 0.1 * std::sin(6.3 * t), 0.03 * std::sin(12.6 * t));
+  return pose;
+}
+
+TEST(TimeOffset, TheModelErrorCovarianceIsOfTheSizeOfTheFirstOrderModelsError) {
+  const double dt = 0.1, h = 1e-4;
+  const auto twist = [&](double t) -> Vector6d {
+    return logSE3(swayingPose(t - h).inverse() * swayingPose(t + h)) / (2 * h);
+  };
+  for (const double offset : {0.01, -0.025}) {
+    double z2 = 0.0;
+    int n = 0;
+    for (int k = 0; k < 100; ++k) {
+      const double t0 = 0.1 * k, t1 = t0 + dt;
+      const Eigen::Isometry3d truth = swayingPose(t0).inverse() * swayingPose(t1);
+      const Eigen::Isometry3d measured =
+          swayingPose(t0 + offset).inverse() * swayingPose(t1 + offset);
+      MotionTwists twists;
+      twists.start = twist(t0 + offset);
+      twists.end = twist(t1 + offset);
+      const Vector6d error = boxMinus(correctedMotion(measured, offset, twists), truth);
+      const Matrix6d covariance = timeOffsetModelCovariance(twists, dt, offset * offset, 1.0);
+      for (int i = 0; i < 6; ++i) {
+        ASSERT_GT(covariance(i, i), 0.0);
+        z2 += error(i) * error(i) / covariance(i, i);
+        ++n;
+      }
+    }
+    // Neither far too small (gating out every point, as on the walking rig) nor far too
+    // large (throwing away what the motion tells).
+    const double rms_z = std::sqrt(z2 / n);
+    EXPECT_LT(rms_z, 1.5) << "offset " << offset;
+    EXPECT_GT(rms_z, 0.05) << "offset " << offset;
+  }
+  // No offset, a constant twist, or the factor 0: nothing to add.
+  MotionTwists constant;
+  constant.start = constant.end = twist(0.3);
+  EXPECT_EQ(timeOffsetModelCovariance(constant, dt, 0.0004, 1.0).norm(), 0.0);
+  MotionTwists changing;
+  changing.start = twist(0.3);
+  changing.end = twist(0.4);
+  EXPECT_EQ(timeOffsetModelCovariance(changing, dt, 0.0, 1.0).norm(), 0.0);
+  EXPECT_EQ(timeOffsetModelCovariance(changing, dt, 0.0004, 0.0).norm(), 0.0);
+  // The sigma grows with the offset squared: twice the offset, 16 times the variance.
+  const double at_10ms = timeOffsetModelCovariance(changing, dt, 0.0001, 1.0)(5, 5);
+  EXPECT_NEAR(timeOffsetModelCovariance(changing, dt, 0.0004, 1.0)(5, 5), 16.0 * at_10ms,
+              1e-9 * at_10ms);
+}
+
 MeasurementScenario offroadWithout(int frames) {
   MeasurementScenario scenario = paperOffroadScenario();
   scenario.frames = frames;

@@ -143,6 +143,10 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "the time offset's estimate is kept within +- this"),
       real("time_offset_drift_ms", &C::time_offset_drift, 1e-3, 0.0, 1000.0,
            "random walk of the time offset per reference step"),
+      real("time_offset_model_noise", &C::time_offset_model_noise, 1.0, 0.0, 100.0,
+           "factor on the motion noise added for the error of the first-order time-offset "
+           "correction (grows with the offset squared and with how fast the twist changes; "
+           "0 = off)"),
       real("odometry_velocity_bias_sigma_mps", &C::odometry_velocity_bias_sigma, 1.0, 0.0, 10.0,
            "steady-state 1 sigma of a slowly varying odometry velocity error, estimated per "
            "lateral and vertical vehicle axis (0 = not estimated)"),

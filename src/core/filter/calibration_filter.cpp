@@ -755,6 +755,12 @@ MatrixXd CalibrationFilter::predictAnew(const MotionIncrement& motion, std::vect
     // The odometry's own covariance of this increment when it gives one, else the model.
     P.bottomRightCorner<6, 6>() =
         motion.has_covariance ? motion.covariance : motionNoiseCovariance(config_, motion.dt);
+    // ... plus what the first-order time-offset correction leaves out (process_model.h).
+    const double offset_variance =
+        time_offset_index_ >= 0 ? covariance_(time_offset_index_, time_offset_index_) : 0.0;
+    P.bottomRightCorner<6, 6>() += timeOffsetModelCovariance(
+        twistsAtEnds(previous_motions_, motion), motion.dt,
+        time_offset_ * time_offset_ + offset_variance, config_.time_offset_model_noise);
     for (TrackedPoint& point : points_) {
       point.B.conservativeResize(3, G);
       point.B.rightCols<6>().setZero();

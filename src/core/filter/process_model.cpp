@@ -81,6 +81,19 @@ Eigen::Isometry3d correctedMotion(const Eigen::Isometry3d& measured, double time
   return expSE3(twists.start * time_offset) * measured * expSE3(-twists.end * time_offset);
 }
 
+Matrix6d timeOffsetModelCovariance(const MotionTwists& twists, double dt,
+                                   double offset_second_moment, double factor) {
+  Matrix6d covariance = Matrix6d::Zero();
+  if (!(dt > 0.0) || !(factor > 0.0) || !(offset_second_moment > 0.0)) return covariance;
+  const Vector6d change = twists.end - twists.start;
+  const double scale = factor * offset_second_moment / dt;
+  const double translation_sigma = scale * change.head<3>().norm();
+  const double rotation_sigma = scale * change.tail<3>().norm();
+  covariance.topLeftCorner<3, 3>().diagonal().setConstant(translation_sigma * translation_sigma);
+  covariance.bottomRightCorner<3, 3>().diagonal().setConstant(rotation_sigma * rotation_sigma);
+  return covariance;
+}
+
 double noiseScale(const FilterConfig& config, double dt) { return dt / config.reference_period; }
 
 Matrix12d calibrationDriftCovariance(const FilterConfig& config, double dt) {
