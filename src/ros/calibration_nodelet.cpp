@@ -2,6 +2,7 @@
 /// @brief CalibrationNodelet: synchronisation, worker thread, services; adapts only.
 #include "online_stereo_calibration/ros/calibration_nodelet.h"
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <sstream>
@@ -319,12 +320,25 @@ bool CalibrationNodelet::preparePipeline(const StereoPair& pair, const cv::Mat& 
 bool CalibrationNodelet::waitForMotion(const ros::Time& stamp, osc::MotionIncrement* motion) {
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.ros.motion_wait);
+  // The odometry is read where the estimator believes the images were: at the stamps minus
+  // its time-offset estimate (MotionIncrement::time_shift); unshifted where that would reach
+  // before time 0.
+  double shift = 0.0;
+  {
+    std::lock_guard<std::mutex> lock(pipeline_mutex_);
+    if (pipeline_) shift = pipeline_->estimator().odometryTimeShift();
+  }
+  if (!last_stamp_.isZero() && std::min(last_stamp_.toSec(), stamp.toSec()) - shift <= 0.0) {
+    shift = 0.0;
+  }
+  const ros::Duration read_shift(shift);
   LookupStatus status = LookupStatus::kEmpty;
   while (true) {
     if (last_stamp_.isZero()) {
       status = motion_->poseAvailable(stamp);
     } else {
-      status = motion_->motionBetween(last_stamp_, stamp, motion);
+      status = motion_->motionBetween(last_stamp_ - read_shift, stamp - read_shift, motion);
+      motion->time_shift = shift;
       const bool previous_lost = status == LookupStatus::kTooOld || status == LookupStatus::kGap;
       if (previous_lost && motion_->poseAvailable(stamp) == LookupStatus::kOk) {
         // The last processed pair's pose is gone (a pause longer than motion_history, the

@@ -685,6 +685,33 @@ TEST(MeasurementSimulator, TimeOffsetReportsTheMotionOfTheShiftedInterval) {
   }
 }
 
+TEST(MeasurementSimulator, AShiftedReadTakesThatMuchOfTheOffsetOut) {
+  // The odometry read at the image stamps minus a shift (the estimator's offset estimate)
+  // reports the motion offset - shift later than the cameras saw it, and says so.
+  const double offset = 0.13;
+  for (double shift : {0.13, 0.05, -0.02}) {
+    SCOPED_TRACE(shift);
+    MeasurementScenario s = noiseFree();
+    s.frames = 30;
+    s.odometry_error.time_offset = offset;
+    MeasurementSimulator sim(s);
+    const VehicleTrajectory reference(s.motion);
+    sim.setOdometryTimeShift(shift);
+    SimulatedFrame f;
+    while (sim.nextFrame(&f)) {
+      if (f.index == 0) continue;
+      const double t0 = f.stamp - 0.1, t1 = f.stamp, rest = offset - shift;
+      const Eigen::Isometry3d read =
+          reference.pose(t0 + rest).inverse() * reference.pose(t1 + rest);
+      ASSERT_TRUE(f.measured_motion.T_prev_curr.isApprox(read, 1e-12)) << "frame " << f.index;
+      EXPECT_EQ(f.measured_motion.time_shift, shift);
+      if (shift == offset) {
+        EXPECT_TRUE(f.measured_motion.T_prev_curr.isApprox(f.true_motion.T_prev_curr, 1e-12));
+      }
+    }
+  }
+}
+
 TEST(MeasurementSimulator, ScaleErrorScalesTheTranslationExactly) {
   MeasurementScenario s = noiseFree();
   s.frames = 50;

@@ -143,6 +143,10 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "the time offset's estimate is kept within +- this"),
       real("time_offset_drift_ms", &C::time_offset_drift, 1e-3, 0.0, 1000.0,
            "random walk of the time offset per reference step"),
+      integer("read_odometry_at_offset", &C::read_odometry_at_offset, 0, 1,
+              "1: the odometry is read at the image stamps minus the current time-offset "
+              "estimate, so that the first-order offset correction covers only its error; 0: "
+              "read at the image stamps"),
       real("time_offset_model_noise", &C::time_offset_model_noise, 1.0, 0.0, 100.0,
            "factor on the motion noise added for the error of the first-order time-offset "
            "correction (grows with the offset squared and with how fast the twist changes; "

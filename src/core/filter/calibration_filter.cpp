@@ -252,7 +252,7 @@ void CalibrationFilter::motionModel(const MotionIncrement& motion, Eigen::Isomet
   const auto model = [&](double time_offset, const Eigen::Vector3d& velocity_bias) {
     Eigen::Isometry3d unbiased = motion.T_prev_curr;
     unbiased.translation() -= velocity_bias * motion.dt;
-    return correctedMotion(unbiased, time_offset, twists);
+    return correctedMotion(unbiased, time_offset - motion.time_shift, twists);
   };
   *corrected = model(time_offset_, velocity_bias_);
   jacobian->setZero(layout::kPoseDim, odometry_dim_);
@@ -705,7 +705,8 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
         last->motion.covariance == motion.covariance &&
         last->motion.has_twists == motion.has_twists &&
         last->motion.twist_start == motion.twist_start &&
-        last->motion.twist_end == motion.twist_end && last->R_excited == R_excited &&
+        last->motion.twist_end == motion.twist_end &&
+        last->motion.time_shift == motion.time_shift && last->R_excited == R_excited &&
         last->extrinsics.T_veh_caml.matrix() == extrinsics_.T_veh_caml.matrix() &&
         last->extrinsics.T_caml_camr.matrix() == extrinsics_.T_caml_camr.matrix() &&
         last->covariance == covariance_ && last->time_offset == time_offset_ &&
@@ -758,9 +759,10 @@ MatrixXd CalibrationFilter::predictAnew(const MotionIncrement& motion, std::vect
     // ... plus what the first-order time-offset correction leaves out (process_model.h).
     const double offset_variance =
         time_offset_index_ >= 0 ? covariance_(time_offset_index_, time_offset_index_) : 0.0;
+    const double residual_offset = time_offset_ - motion.time_shift;
     P.bottomRightCorner<6, 6>() += timeOffsetModelCovariance(
         twistsAtEnds(previous_motions_, motion), motion.dt,
-        time_offset_ * time_offset_ + offset_variance, config_.time_offset_model_noise);
+        residual_offset * residual_offset + offset_variance, config_.time_offset_model_noise);
     for (TrackedPoint& point : points_) {
       point.B.conservativeResize(3, G);
       point.B.rightCols<6>().setZero();

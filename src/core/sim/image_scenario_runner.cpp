@@ -119,7 +119,10 @@ std::vector<ImageFrameResult> runImageScenario(
   // dark images of a blind frame) adds its motion to the next pair's.
   std::optional<MotionIncrement> since_processed;
   SimulatedFrame frame;
-  while (simulator.nextFrame(&frame)) {
+  while (true) {
+    // The odometry read where the estimator believes the images were (its time offset).
+    simulator.setOdometryTimeShift(pipeline.estimator().odometryTimeShift());
+    if (!simulator.nextFrame(&frame)) break;
     ImageFrameResult r;
     const Eigen::Isometry3d T_world_lopt = frame.T_world_veh * frame.truth.vehicleToLeftOptical();
     const Eigen::Isometry3d T_world_ropt = T_world_lopt * frame.truth.leftToRightOptical();

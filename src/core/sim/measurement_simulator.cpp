@@ -133,9 +133,11 @@ bool MeasurementSimulator::nextFrame(SimulatedFrame* frame) {
   if (out.index > 0) {
     const double previous = (out.index - 1) * dt;
     out.true_motion.T_prev_curr = trueMotion(previous, out.stamp);
-    // The odometry's clock runs time_offset ahead of the cameras'.
+    // The odometry's clock runs time_offset ahead of the cameras'; read at the image stamps
+    // minus the shift, it gives the motion time_offset - shift later than the cameras saw.
     MotionIncrement reported = out.true_motion;
-    const double offset = scenario_.odometry_error.time_offset;
+    const double shift = odometryReadShift(previous, out.stamp);
+    const double offset = scenario_.odometry_error.time_offset - shift;
     if (offset != 0.0) reported.T_prev_curr = trueMotion(previous + offset, out.stamp + offset);
     out.measured_motion = perturbMotion(odometry_error_.apply(reported));
     // The odometry's twists at both ends, on its clock and in its scale (exact derivatives:
@@ -143,6 +145,7 @@ bool MeasurementSimulator::nextFrame(SimulatedFrame* frame) {
     out.measured_motion.has_twists = true;
     out.measured_motion.twist_start = measuredTwist(previous + offset);
     out.measured_motion.twist_end = measuredTwist(out.stamp + offset);
+    out.measured_motion.time_shift = shift;
   }
   if (scenario_.isBlindFrame(out.index)) {
     // Nothing can be tracked: every track is lost, none is born (no random draws either).
@@ -161,8 +164,17 @@ bool MeasurementSimulator::nextFrame(SimulatedFrame* frame) {
   return true;
 }
 
+double MeasurementSimulator::odometryReadShift(double t0, double t1) const {
+  if (odometry_time_shift_ == 0.0 || !recorded_) return odometry_time_shift_;
+  constexpr double kTwistStep = 1e-3;  // measuredTwist's central difference
+  const double offset = scenario_.odometry_error.time_offset - odometry_time_shift_;
+  const bool recorded = recorded_start_ + t0 + offset - kTwistStep >= recorded_->firstStamp() &&
+                        recorded_start_ + t1 + offset + kTwistStep <= recorded_->lastStamp();
+  return recorded ? odometry_time_shift_ : 0.0;
+}
+
 Vector6d MeasurementSimulator::measuredTwist(double t) const {
-  constexpr double h = 1e-3;  // s, central difference of the true pose
+  constexpr double h = 1e-3;  // s, central difference of the true pose (odometryReadShift)
   Vector6d twist = logSE3(trueMotion(t - h, t + h)) / (2.0 * h);
   twist.head<3>() *= 1.0 + scenario_.odometry_error.scale_error;
   return twist;

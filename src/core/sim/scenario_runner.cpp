@@ -42,7 +42,10 @@ std::vector<ScenarioFrameResult> runMeasurementScenario(
   std::vector<ScenarioFrameResult> results;
   results.reserve(scenario.frames);
   SimulatedFrame frame;
-  while (simulator.nextFrame(&frame)) {
+  while (true) {
+    // The odometry read where the estimator believes the images were (its time offset).
+    simulator.setOdometryTimeShift(estimator.odometryTimeShift());
+    if (!simulator.nextFrame(&frame)) break;
     if (declare_config_pixel_noise) {
       for (auto& observation : frame.observations) {
         observation.sigma_left = observation.sigma_right = 0.0;

@@ -241,12 +241,16 @@ int evaluateBag(const Options& options) {
     const double stamp = left->header.stamp.toSec();
     osc::MotionIncrement motion;
     if (have_previous) {
-      const auto increment = odometry.motionBetween(previous_stamp, stamp, kOdomTolerance);
+      // Read where the estimator believes the images were (its time offset), as the node.
+      const double shift = pipeline.estimator().odometryTimeShift();
+      const auto increment =
+          odometry.motionBetween(previous_stamp - shift, stamp - shift, kOdomTolerance);
       if (increment) {
         motion = *increment;
+        motion.time_shift = shift;
         // The odometry's own twists at both stamps for the time offset, as the node does.
-        motion.has_twists = odometry_twists.twistAt(previous_stamp, &motion.twist_start) &&
-                            odometry_twists.twistAt(stamp, &motion.twist_end);
+        motion.has_twists = odometry_twists.twistAt(previous_stamp - shift, &motion.twist_start) &&
+                            odometry_twists.twistAt(stamp - shift, &motion.twist_end);
       } else {
         std::cerr << "\nevaluate: no odometry around pair " << frame << " (stamp " << stamp
                   << "); tracking restarts\n";

@@ -161,6 +161,11 @@ struct FilterConfig {
   /// default campaign (docs/RESULTS.md "Session 16": 123 -> 128 honest runs, frames beyond
   /// 5 sigma 2566 -> 2123; with 1: 129 and 2518).
   double time_offset_model_noise = 0.5;
+  /// 1: callers read the odometry at the image stamps minus the current time-offset estimate
+  /// (StereoCalibrationEstimator::odometryTimeShift; the node, evaluate and the simulators
+  /// do), as VINS and OpenVINS read the IMU; the first-order correction then covers only the
+  /// estimate's error. 0: read at the image stamps, the correction covers the whole offset.
+  int read_odometry_at_offset = 1;
   /// Steady-state 1 sigma (m/s, per vehicle axis) of a slowly varying additive error of the
   /// odometry's velocity (wheel slip, a tilted or drifting IMU): a first-order Gauss-Markov
   /// state b with correlation time odometry_bias_correlation_time; the measured translation

@@ -111,6 +111,14 @@ class StereoCalibrationEstimator {
   void reset(const StereoExtrinsics& guess, const Matrix12d& tangent_covariance);
 
   CalibrationEstimate estimate() const;
+  /// s: read the odometry for the next pair at the image stamps minus this and say so in
+  /// MotionIncrement::time_shift. It is the current estimate of the camera-odometry time
+  /// offset (FilterConfig::read_odometry_at_offset; else 0), so that the filter's
+  /// first-order offset correction (process_model.h correctedMotion), which errs on a jerky
+  /// rig, covers only the estimate's error.
+  double odometryTimeShift() const {
+    return config_.read_odometry_at_offset != 0 ? filter_.timeOffset() : 0.0;
+  }
   const CalibrationFilter& filter() const { return filter_; }
   const CameraModel& leftCamera() const { return left_; }
   const CameraModel& rightCamera() const { return right_; }

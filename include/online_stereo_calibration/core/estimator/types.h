@@ -33,6 +33,13 @@ struct MotionIncrement {
   /// then uses it instead of the configured motion noise. Symmetric positive semi-definite.
   bool has_covariance = false;
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  /// s: the odometry was read at the two image stamps minus this (and the twists there), so
+  /// that this much of the camera-odometry time offset is already taken out; the filter's
+  /// first-order correction covers only the rest (FilterConfig::initial_time_offset's
+  /// convention). Callers that can read the odometry at any time use
+  /// StereoCalibrationEstimator::odometryTimeShift() (as VINS / OpenVINS read the IMU at the
+  /// image time plus the estimated offset); 0 = read at the image stamps.
+  double time_shift = 0.0;
 };
 
 /// One point seen in both images of a stereo pair.

@@ -68,6 +68,12 @@ class MeasurementSimulator {
   /// Fills the next frame; false when all scenario.frames were produced (frame untouched).
   bool nextFrame(SimulatedFrame* frame);
 
+  /// Read the odometry for the next frames at the image stamps minus @p shift (s), as a
+  /// caller does with StereoCalibrationEstimator::odometryTimeShift(); the frame's
+  /// measured_motion.time_shift says it. 0 (the default) reads at the image stamps. A shifted
+  /// read that would leave a recorded trajectory is made unshifted (time_shift 0).
+  void setOdometryTimeShift(double shift) { odometry_time_shift_ = shift; }
+
   /// The estimator lost or rejected these points; like a real tracker, stop reporting them
   /// (they die). Unknown or dead ids are ignored.
   void dropTracks(const std::vector<PointId>& ids);
@@ -89,6 +95,9 @@ class MeasurementSimulator {
   Eigen::Isometry3d trueMotion(double t0, double t1) const;
   /// The body twist [v, w] the odometry reports at its time t (true, times its scale error).
   Vector6d measuredTwist(double t) const;
+  /// The shift the odometry of the increment from drive time t0 to t1 is read with:
+  /// setOdometryTimeShift's, or 0 if that read would leave the recorded trajectory.
+  double odometryReadShift(double t0, double t1) const;
   /// The vehicle's world x-y positions over the drive [0, frames / rate_hz] (clamped to the
   /// recording), for SceneConfig::path of the image-level renderer: at most 1 m apart for
   /// the analytic profile (the scene decimates to 1 m), every recorded pose in between for a
@@ -169,6 +178,7 @@ class MeasurementSimulator {
   RandomStream moving_rng_;              ///< which born points move, and where (stream 5)
   OdometryErrorProcess odometry_error_;  ///< scale error and biases (stream 4)
   int next_frame_ = 0;
+  double odometry_time_shift_ = 0.0;  ///< setOdometryTimeShift
   std::vector<Track> live_;
   /// Every point ever born, indexed by id - 1 (ids are 1, 2, 3, ...).
   std::vector<BornPoint> born_points_;
