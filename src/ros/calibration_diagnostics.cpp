@@ -254,9 +254,12 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
   }
   // The camera-odometry time offset (issue 15), when it is estimated.
   if (have_estimate_ && estimate_.time_offset_sigma > 0.0) {
-    status.add("odometry time offset [ms]", std::to_string(estimate_.time_offset * 1e3) + " +- " +
-                                                std::to_string(estimate_.time_offset_sigma * 1e3) +
-                                                " (odometry clock minus camera clock, 1 sigma)");
+    status.add(
+        "odometry time offset [ms]",
+        std::to_string(estimate_.time_offset * 1e3) + " +- " +
+            std::to_string(estimate_.time_offset_sigma * 1e3) +
+            " (camera clock minus odometry clock: the odometry stamped t holds the vehicle at "
+            "camera time t + offset; 1 sigma)");
   }
   // x_camr's drift rate (issue 15), when it is estimated.
   if (have_estimate_ && estimate_.camr_drift_rate_sigma.maxCoeff() > 0.0) {

@@ -48,8 +48,9 @@ Vector6d twistAt(double t) {
 TEST(TimeOffset, CorrectedMotionRecoversTheTrueIncrement) {
   const double offset = 0.025, dt = 0.1;
   for (double t0 : {0.5, 1.3, 2.0}) {
-    // The odometry's clock runs `offset` ahead: between the image stamps it reports the
-    // motion up to `offset` later (the simulator's convention, odometry_error.h).
+    // The odometry's sample stamped t holds the vehicle at camera time t + offset: between
+    // the image stamps it reports the motion up to `offset` later (the simulator's
+    // convention, FilterConfig::initial_time_offset).
     std::vector<MotionIncrement> earlier;
     for (int k = kTwistTrendIncrements; k > 0; --k)
       earlier.push_back(increment(t0 - k * dt + offset, t0 - (k - 1) * dt + offset));

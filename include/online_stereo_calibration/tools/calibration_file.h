@@ -31,8 +31,9 @@ struct CalibrationFile {
   /// Full 12x12 covariance of the 12 parameters (m^2, m rad, rad^2), when the file has it.
   /// Symmetric positive definite; its diagonal is sigmas^2 when both are present.
   std::optional<Matrix12d> covariance;
-  /// The estimated camera-odometry time offset and its 1 sigma (s; odometry clock minus
-  /// camera clock), when the file has them (`time_offset`, `sigma_time_offset`).
+  /// The estimated camera-odometry time offset and its 1 sigma (s; camera clock minus
+  /// odometry clock, FilterConfig::initial_time_offset), when the file has them (`time_offset`,
+  /// `sigma_time_offset`).
   std::optional<double> time_offset;
   std::optional<double> time_offset_sigma;
 };

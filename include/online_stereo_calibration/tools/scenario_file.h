@@ -27,7 +27,7 @@
 ///          stop_ramp: 1.0}                    # s of smooth slow-down / speed-up
 /// motion_rotation_noise: 3.49e-4     # rad per axis per 0.1 s (odometry white noise)
 /// motion_translation_noise: 0.002    # m per axis per 0.1 s
-/// odometry_error: {time_offset: 0,          # s, odometry clock ahead of the cameras
+/// odometry_error: {time_offset: 0,          # s, camera clock minus odometry clock
 ///                  scale_error: 0,          # translation x (1 + scale_error)
 ///                  rotation_rate_bias: 0,   # rad/s, steady-state std per axis
 ///                  velocity_bias: 0,        # m/s, steady-state std per axis

@@ -136,7 +136,9 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "shrink (a start or re-opening far off) is tempered and spread over frames; "
            "0 = off"),
       real("initial_time_offset_ms", &C::initial_time_offset, 1e-3, -1000.0, 1000.0,
-           "prior mean of the odometry clock minus the camera clock"),
+           "prior mean of the camera clock minus the odometry clock (the odometry's sample "
+           "stamped t holds the vehicle at camera time t + offset; a late-stamping odometry "
+           "has a negative offset)"),
       real("initial_time_offset_sigma_ms", &C::initial_time_offset_sigma, 1e-3, 0.0, 1000.0,
            "prior 1 sigma of the camera-odometry time offset (0 = not estimated)"),
       real("max_time_offset_ms", &C::max_time_offset, 1e-3, 0.0, 1000.0,

@@ -133,8 +133,9 @@ bool MeasurementSimulator::nextFrame(SimulatedFrame* frame) {
   if (out.index > 0) {
     const double previous = (out.index - 1) * dt;
     out.true_motion.T_prev_curr = trueMotion(previous, out.stamp);
-    // The odometry's clock runs time_offset ahead of the cameras'; read at the image stamps
-    // minus the shift, it gives the motion time_offset - shift later than the cameras saw.
+    // The odometry's sample stamped t holds the vehicle at camera time t + time_offset; read
+    // at the image stamps minus the shift, it gives the motion time_offset - shift later than
+    // the cameras saw it.
     MotionIncrement reported = out.true_motion;
     const double shift = odometryReadShift(previous, out.stamp);
     const double offset = scenario_.odometry_error.time_offset - shift;

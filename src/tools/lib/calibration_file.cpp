@@ -204,7 +204,7 @@ std::string formatCalibrationYaml(const CalibrationFile& file) {
   if (file.stamp) text += std::string(kStamp) + ": " + formatNumber(*file.stamp) + "\n";
   if (file.time_offset) {
     text += std::string(kTimeOffset) + ": " + formatNumber(*file.time_offset) +
-            "  # s, odometry clock minus camera clock (estimated)\n";
+            "  # s, camera clock minus odometry clock (estimated)\n";
   }
   if (file.time_offset_sigma)
     text += std::string(kSigmaTimeOffset) + ": " + formatNumber(*file.time_offset_sigma) + "\n";

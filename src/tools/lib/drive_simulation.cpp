@@ -135,8 +135,8 @@ std::vector<StampedPose> DriveSimulator::odometry() const {
   std::mt19937_64 engine(0x5eedULL * (scenario_.measurement.seed + 1ULL) + 17ULL);
   std::normal_distribution<double> normal(0.0, 1.0);
   OdometryErrorProcess errors(scenario_.measurement.odometry_error, scenario_.measurement.seed);
-  // The odometry's clock runs time_offset ahead: the sample stamped start_stamp + k * period
-  // holds the true motion up to drive time k * period + time_offset.
+  // The camera clock minus the odometry's is time_offset: the sample stamped start_stamp + k *
+  // period holds the true motion up to drive time k * period + time_offset.
   const double offset = scenario_.measurement.odometry_error.time_offset;
   std::vector<StampedPose> out;
   out.reserve(samples);

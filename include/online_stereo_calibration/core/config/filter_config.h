@@ -143,8 +143,11 @@ struct FilterConfig {
   double max_sigma_shrink_per_update = 3.0;
 
   // --- the odometry's own errors as states (issue 15; process_model.h correctedMotion) ---
-  /// Prior mean (s) of the camera-odometry time offset: the odometry's clock minus the
-  /// cameras' (the odometry stamps a motion `time_offset` later than the cameras see it).
+  /// Prior mean (s) of the camera-odometry time offset d: the camera clock minus the
+  /// odometry's, i.e. the odometry's sample stamped t holds the vehicle at camera time t + d
+  /// (an odometry that stamps its samples late, by its processing delay, has d < 0).
+  /// Documented as "odometry clock minus camera clock" until session 16: the sign of the
+  /// words was wrong, the model and the simulators always used this one.
   double initial_time_offset = 0.0;
   /// Prior 1 sigma (s) of that offset; 0 = not estimated (the offset is taken as the prior
   /// mean). 10 ms at 10 m/s moves the camera 10 cm between what the odometry and the images

@@ -32,8 +32,9 @@ struct CalibrationEstimate {
   Eigen::Vector3d excitation = Eigen::Vector3d::Ones();
   /// The filter's consistency monitor: per-block statistics and the drift-noise factors.
   ConsistencyStatus consistency;
-  /// The camera-odometry time offset (CalibrationFilter::timeOffset): odometry clock minus
-  /// camera clock (s), and its 1 sigma (0 = not estimated).
+  /// The camera-odometry time offset (CalibrationFilter::timeOffset): camera clock minus
+  /// odometry clock (s; FilterConfig::initial_time_offset), and its 1 sigma (0 = not
+  /// estimated).
   double time_offset = 0.0;
   double time_offset_sigma = 0.0;
   /// The rate at which x_camr's rotation drifts (CalibrationFilter::camrDriftRate; rad/s,

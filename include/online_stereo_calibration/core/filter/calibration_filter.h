@@ -128,7 +128,7 @@ class CalibrationFilter {
   Matrix12d parameterCovariance() const;
 
   /// The camera-odometry time offset state (FilterConfig::initial_time_offset_sigma;
-  /// process_model.h correctedMotion): odometry clock minus camera clock (s), and its 1 sigma
+  /// process_model.h correctedMotion): camera clock minus odometry clock (s), and its 1 sigma
   /// (0 when not estimated).
   double timeOffset() const { return time_offset_; }
   double timeOffsetSigma() const { return stateSigma(time_offset_index_); }
@@ -223,7 +223,7 @@ class CalibrationFilter {
   int velocity_bias_index_ = -1;  ///< first of velocity_bias_axes_.size()
   /// The vehicle axes (0 x forward, 1 y, 2 z) whose velocity error is a state, in order.
   std::vector<int> velocity_bias_axes_;
-  double time_offset_ = 0.0;  ///< s, odometry clock minus camera clock
+  double time_offset_ = 0.0;  ///< s, camera clock minus odometry clock
   Eigen::Vector3d velocity_bias_ = Eigen::Vector3d::Zero();  ///< m/s, vehicle axes
   /// x_camr's rotation drift rate (FilterConfig::camr_rotation_drift_rate_sigma): 3 states
   /// after the odometry's, or none.

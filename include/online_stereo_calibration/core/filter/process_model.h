@@ -60,8 +60,9 @@ MotionTwists twistsAtEnds(const std::vector<MotionIncrement>& earlier,
                           const MotionIncrement& current);
 
 /// Our model of the odometry's time offset (issue 15; not in the paper). The odometry's
-/// clock runs `time_offset` (d) ahead of the cameras', so the increment measured between the
-/// image stamps t0 and t1 is M = T(t0 + d)^-1 T(t1 + d). With T(t + d) = T(t) Exp(d xi(t))
+/// sample stamped t holds the vehicle at camera time t + d (d = `time_offset`: the camera
+/// clock minus the odometry's), so the increment read at the image stamps t0 and t1 is
+/// M = T(t0 + d)^-1 T(t1 + d). With T(t + d) = T(t) Exp(d xi(t))
 /// (xi: body twist), the vehicle's true motion between the two image pairs is
 ///   T(t0)^-1 T(t1) = Exp(d xi(t0)) M Exp(-d xi(t1)).
 /// A constant twist gives M back whatever d: only a change of motion shows the offset.
