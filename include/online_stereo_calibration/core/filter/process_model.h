@@ -70,8 +70,9 @@ Eigen::Isometry3d correctedMotion(const Eigen::Isometry3d& measured, double time
                                   const MotionTwists& twists);
 
 /// Covariance [dt (3), dtheta (3)] of what correctedMotion leaves out. It takes each end's
-/// twist as constant over the offset d; a twist that changes at the rate a errs by about
-/// a d^2 / 2 per end. With a taken as the change of twist over the increment,
+/// twist as constant over the offset d, so each end errs by about a d^2 / 2 (a: the twist's
+/// rate there); the two ends cancel for a steady rate and not for a jerky one. An empirical
+/// scale, not a derivation: with a taken as the change of twist over the increment,
 /// |xi(t1) - xi(t0)| / dt, each axis gets the 1 sigma factor * |change| E[d^2] / dt, where
 /// E[d^2] = offset^2 + its variance (the linear part is the offset state's own Jacobian).
 /// Measured on the recorded walking rig (udel_gore, d = 18 ms): the first-order model
