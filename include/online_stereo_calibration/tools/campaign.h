@@ -58,7 +58,8 @@ void storeOrCheckCampaignInputs(const std::string& dir, const CampaignInputs& in
 std::vector<CampaignRow> runCampaign(const CampaignInputs& inputs, const CampaignOptions& options);
 
 /// --only K: runs run @p run alone (in this process) into DIR/run_K/: estimates.csv and
-/// reference.csv (the per-frame estimate and truth, estimates_csv.h), run.csv (its campaign
+/// reference.csv (the per-frame estimate and truth, estimates_csv.h), events.txt (a line per
+/// frame in which the estimator tempered, restarted, re-opened or warned), run.csv (its campaign
 /// row), settings.txt (scores and drawn settings, also written to @p report if given) and,
 /// with @p plot, the plots of scripts/plot_convergence.py as `evaluate` makes them. The inputs
 /// are stored in or checked against DIR (storeOrCheckCampaignInputs). Returns the row.

@@ -135,6 +135,13 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "largest factor by which one update may shrink a calibration sigma; a larger "
            "shrink (a start or re-opening far off) is tempered and spread over frames; "
            "0 = off"),
+      integer("thin_evidence_points", &C::thin_evidence_points, 0, 100000,
+              "until this many distinct points have been measured since a start or "
+              "re-opening, no started sigma falls below its start value / "
+              "thin_evidence_max_shrink; 0 = off"),
+      real("thin_evidence_max_shrink", &C::thin_evidence_max_shrink, 1.0, 1.0, 1e6,
+           "how far below its start value a sigma may fall on thin evidence (see "
+           "thin_evidence_points)"),
       real("initial_time_offset_ms", &C::initial_time_offset, 1e-3, -1000.0, 1000.0,
            "prior mean of the camera clock minus the odometry clock (the odometry's sample "
            "stamped t holds the vehicle at camera time t + offset; a late-stamping odometry "
@@ -275,6 +282,7 @@ FilterConfig paperFilterConfig() {
   config.consistency_window = 0.0;            // the paper's random walk is fixed
   config.relinearization_frames = 0;          // the paper's filter runs on from its start
   config.max_sigma_shrink_per_update = 0.0;   // ... and updates as the UKF does
+  config.thin_evidence_points = 0;            // ... on any evidence
   config.initial_time_offset_sigma = 0.0;     // the paper takes the odometry as synchronised
   config.odometry_scale_sigma = 0.0;          // ... and exact in scale
   config.odometry_velocity_bias_sigma = 0.0;  // ... and without a velocity error

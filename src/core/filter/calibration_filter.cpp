@@ -298,6 +298,7 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& co
   excitation_.reset();
   monitor_.reset();
   time_since_opened_ = {0.0, 0.0};
+  floorOnThinEvidence(0, layout::kCalibrationDim);
   rejection_streak_ = 0;
   points_.clear();
   index_.clear();
@@ -614,8 +615,23 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   std::vector<LinearizedMeasurement> linearized;
   linearized.reserve(used.size());
   for (const PointInnovation* inn : used) linearized.push_back({&inn->J, &inn->S0});
+  // ... nor, after a start or re-opening, below its floor before enough points were
+  // measured. Measured, not only used: from a start far off most points may be gated out for
+  // some frames, and holding the update back then kept it there (image-level campaign runs
+  // 0, 10-12: 0-15 frames beyond 5 sigma became 150-170 when only used points counted).
+  if (final_pass && (thin_evidence_floor_.array() > 0.0).any()) {
+    for (const PointInnovation& inn : innovations) {
+      thin_evidence_support_.insert(points_[inn.point].id);
+    }
+    if (static_cast<int>(thin_evidence_support_.size()) >= config_.thin_evidence_points) {
+      thin_evidence_floor_.setZero();
+      thin_evidence_support_.clear();
+    }
+  }
+  const Eigen::VectorXd floor = thin_evidence_floor_;
   const double tempering =
-      updateTempering(P, linearized, layout::kCalibrationDim, config_.max_sigma_shrink_per_update);
+      updateTempering(P, linearized, layout::kCalibrationDim, config_.max_sigma_shrink_per_update,
+                      (floor.array() > 0.0).any() ? &floor : nullptr);
   report.tempering = tempering;
   // The update's information for the consistency monitor (consistency_monitor.h):
   // A = sum J^T S0^-1 J, b = sum J^T S0^-1 v, c = sum v^T S0^-1 v with v = r - J dg_prior.
@@ -933,6 +949,15 @@ void CalibrationFilter::widenBlock(JumpBlock block, double translation_sigma,
   covariance_.middleCols<6>(first).setZero();
   covariance_.block<6, 6>(first, first) = variance.asDiagonal();
   time_since_opened_[blockIndex(block)] = 0.0;
+  floorOnThinEvidence(first, 6);
+}
+
+void CalibrationFilter::floorOnThinEvidence(int first, int count) {
+  if (config_.thin_evidence_points <= 0) return;
+  const double shrink = config_.thin_evidence_max_shrink;
+  thin_evidence_floor_.segment(first, count) =
+      covariance_.diagonal().segment(first, count) / (shrink * shrink);
+  thin_evidence_support_.clear();
 }
 
 bool CalibrationFilter::repairCovariance() {

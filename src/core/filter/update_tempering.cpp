@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include <Eigen/Cholesky>
@@ -39,22 +40,41 @@ Eigen::MatrixXd updatedCovariance(const Eigen::MatrixXd& P,
 
 double updateTempering(const Eigen::MatrixXd& P,
                        const std::vector<LinearizedMeasurement>& measurements, int limited,
-                       double max_shrink) {
-  if (!(max_shrink > 1.0) || measurements.empty()) return 1.0;
-  const double bound = max_shrink * max_shrink;  // on the variance ratio
+                       double max_shrink, const Eigen::VectorXd* variance_floor) {
+  if (measurements.empty()) return 1.0;
   limited = std::min(limited, static_cast<int>(P.rows()));
+  // The largest allowed prior / posterior variance ratio of each limited component.
+  Eigen::VectorXd bound = Eigen::VectorXd::Constant(
+      limited,
+      max_shrink > 1.0 ? max_shrink * max_shrink : std::numeric_limits<double>::infinity());
+  if (variance_floor) {
+    for (int k = 0; k < limited; ++k) {
+      if ((*variance_floor)(k) > 0.0 && P(k, k) > 0.0) {
+        bound(k) = std::min(bound(k), std::max(P(k, k) / (*variance_floor)(k), 1.0));
+      }
+    }
+  }
+  if (!(bound.minCoeff() < std::numeric_limits<double>::infinity())) return 1.0;
+  // A variance at its floor may not shrink at all: the update is held back (S0 scaled so
+  // far up that it changes nothing measurable).
+  constexpr double kHeldBack = 1e12;
   double alpha = 1.0;
   constexpr int kSteps = 4;
   for (int step = 0; step < kSteps; ++step) {
     const Eigen::MatrixXd Q = updatedCovariance(P, measurements, alpha);
-    double ratio = 1.0;  // largest prior / posterior variance
+    double factor = 1.0;  // by which alpha must grow for the most violated bound
     for (int k = 0; k < limited; ++k) {
-      if (Q(k, k) > 0.0 && P(k, k) > 0.0) ratio = std::max(ratio, P(k, k) / Q(k, k));
+      if (!(Q(k, k) > 0.0 && P(k, k) > 0.0)) continue;
+      const double ratio = P(k, k) / Q(k, k);
+      if (!(ratio > bound(k) * (1.0 + 1e-6))) continue;
+      // One dimension: P / Q = 1 + I P / alpha, so alpha' = alpha (ratio - 1) / (bound - 1)
+      // gives exactly the bound.
+      factor = bound(k) - 1.0 > 1e-9 ? std::max(factor, (ratio - 1.0) / (bound(k) - 1.0))
+                                     : std::numeric_limits<double>::infinity();
     }
-    if (!(ratio > bound * (1.0 + 1e-6))) break;
-    // One dimension: P / Q = 1 + I P / alpha, so alpha' = alpha (ratio - 1) / (bound - 1)
-    // gives exactly the bound.
-    alpha *= (ratio - 1.0) / (bound - 1.0);
+    if (!(factor > 1.0)) break;
+    alpha = std::min(alpha * factor, kHeldBack);
+    if (alpha >= kHeldBack) break;
   }
   return alpha;
 }

@@ -10,6 +10,20 @@
 #include "online_stereo_calibration/tools/package_files.h"
 
 namespace osc {
+namespace {
+
+/// One line per frame in which the estimator restarted, re-opened, re-seeded, tempered its
+/// update or warned; nothing for a quiet frame.
+void appendFrameEvents(const ScenarioFrameResult& r, std::ostream* out) {
+  std::ostringstream line;
+  if (r.tempering > 1.0) line << " update tempered x" << r.tempering << ";";
+  if (r.relinearized) line << " restarted from its estimate (re-linearised);";
+  if (r.jump_detected) line << " sudden change detected;";
+  for (const std::string& warning : r.warnings) line << " " << warning << ";";
+  if (line.tellp() > 0) *out << "frame " << r.frame << ":" << line.str() << "\n";
+}
+
+}  // namespace
 
 CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& out, int run,
                               bool plot, std::ostream* report) {
@@ -25,9 +39,11 @@ CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& o
   }
   EstimatesCsvWriter estimates(dir + "/estimates.csv");
   ReferenceCsvWriter reference(dir + "/reference.csv");
+  std::ostringstream events;  // what the estimator did when, to read beside the plots
   const auto on_frame = [&](const ScenarioFrameResult& r) {
     estimates.write(estimateRowOf(r));
     reference.write(referenceRowOf(r));
+    appendFrameEvents(r, &events);
   };
   CampaignRow row;
   try {
@@ -41,6 +57,7 @@ CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& o
   row.settings = spec.settings;
   estimates.flush();
   reference.flush();
+  writeTextFileAtomic(dir + "/events.txt", events.str());
 
   const std::vector<std::string> names = campaignSettingNames(inputs.images);
   writeTextFileAtomic(dir + "/run.csv",
@@ -74,7 +91,7 @@ CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& o
     }
   }
   if (report) {
-    *report << "wrote " << dir << "/estimates.csv, reference.csv, run.csv, settings.txt"
+    *report << "wrote " << dir << "/estimates.csv, reference.csv, events.txt, run.csv, settings.txt"
             << (plot ? ", plots" : "") << "\n";
   }
   return row;

@@ -141,6 +141,17 @@ struct FilterConfig {
   /// the default campaign (200 runs, docs/RESULTS.md "Session 15"): 112 -> 123 honest runs,
   /// frames beyond 5 sigma 4101 -> 2566, RMSE unchanged or better.
   double max_sigma_shrink_per_update = 3.0;
+  /// No collapse on thin evidence (issue 14): until this many distinct points have been
+  /// measured (predicted and compared, whether used or gated out) since a start or a block's
+  /// re-opening, none of the started (re-opened) sigmas falls below its start value /
+  /// thin_evidence_max_shrink (the update is tempered, update_tempering.h; one at its floor
+  /// holds the update back). 0 = off, the default: 20 made the default campaign's run 24
+  /// honest (x_camr 4.7 deg off, one point: yaw_r 7 sigma wrong for 435 frames without) and
+  /// gave 139 instead of 134 honest runs, but at image level it held back the first updates
+  /// of starts far off that see only 2-6 points per frame, and 4 of 20 image runs became
+  /// 114-170 frames beyond 5 sigma; 5 changed nothing (docs/RESULTS.md "Session 17").
+  int thin_evidence_points = 0;
+  double thin_evidence_max_shrink = 3.0;
 
   // --- the odometry's own errors as states (issue 15; process_model.h correctedMotion) ---
   /// Prior mean (s) of the camera-odometry time offset d: the camera clock minus the

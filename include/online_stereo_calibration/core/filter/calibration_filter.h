@@ -19,6 +19,7 @@
 #include <memory>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include <Eigen/Core>
@@ -239,6 +240,14 @@ class CalibrationFilter {
   std::array<double, 2> time_since_opened_ = {0.0, 0.0};
   /// Frames in a row with at least jump_sustained_rejected_fraction of the points gated out.
   int rejection_streak_ = 0;
+  /// No collapse on thin evidence (FilterConfig::thin_evidence_points): the variance floors
+  /// of the calibration components started or re-opened (0: none), and the points measured
+  /// since; the floors go when there are enough of them.
+  Vector12d thin_evidence_floor_ = Vector12d::Zero();
+  std::unordered_set<PointId> thin_evidence_support_;
+  /// Floors calibration components [first, first + count) at their variance now / the
+  /// configured shrink squared, and starts counting support afresh.
+  void floorOnThinEvidence(int first, int count);
   PointCoordinates coordinates_;  ///< how TrackedPoint::mean stores a point
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "online_stereo_calibration/core/config/filter_config.h"
@@ -28,6 +29,13 @@ struct ScenarioFrameResult {
   int tracked_points = 0;
   int new_points = 0;
   bool jump_detected = false;
+  /// The step's update tempering factor (StepReport::tempering; 1 = untempered).
+  double tempering = 1.0;
+  /// The filter was restarted from its estimate (FrameReport::relinearized).
+  bool relinearized = false;
+  /// The estimator's warnings for this frame (FrameReport::warnings: restarts, re-openings,
+  /// re-seeds, rejected motion), for a run's event log.
+  std::vector<std::string> warnings;
   /// isConverged(estimate, ConvergenceThresholds()) after this frame (convergence.h).
   bool converged = false;
   double time_ms = 0.0;  ///< estimator time for this frame
