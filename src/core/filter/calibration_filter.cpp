@@ -616,10 +616,9 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   linearized.reserve(used.size());
   for (const PointInnovation* inn : used) linearized.push_back({&inn->J, &inn->S0});
   // ... nor, after a start or re-opening, below its floor before enough points were
-  // measured. Measured, not only used: from a start far off most points may be gated out for
-  // some frames, and holding the update back then kept it there (image-level campaign runs
-  // 0, 10-12: 0-15 frames beyond 5 sigma became 150-170 when only used points counted).
-  if (final_pass && (thin_evidence_floor_.array() > 0.0).any()) {
+  // measured (gated out or not: it is the amount of data that is thin, not its agreement).
+  const bool floored = (thin_evidence_floor_.array() > 0.0).any();
+  if (final_pass && floored) {
     for (const PointInnovation& inn : innovations) {
       thin_evidence_support_.insert(points_[inn.point].id);
     }
@@ -628,10 +627,12 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
       thin_evidence_support_.clear();
     }
   }
-  const Eigen::VectorXd floor = thin_evidence_floor_;
+  const Eigen::VectorXd floor = (thin_evidence_floor_.array() > 0.0).any()
+                                    ? Eigen::VectorXd(thin_evidence_floor_)
+                                    : Eigen::VectorXd();  // none, or released above
   const double tempering =
       updateTempering(P, linearized, layout::kCalibrationDim, config_.max_sigma_shrink_per_update,
-                      (floor.array() > 0.0).any() ? &floor : nullptr);
+                      floor.size() > 0 ? &floor : nullptr);
   report.tempering = tempering;
   // The update's information for the consistency monitor (consistency_monitor.h):
   // A = sum J^T S0^-1 J, b = sum J^T S0^-1 v, c = sum v^T S0^-1 v with v = r - J dg_prior.

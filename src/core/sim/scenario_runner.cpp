@@ -26,7 +26,6 @@ ScenarioFrameResult makeFrameResult(const SimulatedFrame& frame,
   r.new_points = report.new_points;
   r.jump_detected = report.step.jump != JumpBlock::kNone;
   r.tempering = report.step.tempering;
-  r.relinearized = report.relinearized;
   r.warnings = report.warnings;
   r.converged = isConverged(estimate, ConvergenceThresholds());
   r.time_ms = time_ms;

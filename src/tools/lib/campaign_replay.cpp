@@ -12,13 +12,11 @@
 namespace osc {
 namespace {
 
-/// One line per frame in which the estimator restarted, re-opened, re-seeded, tempered its
-/// update or warned; nothing for a quiet frame.
+/// One line per frame in which the estimator tempered its update or warned (restarts,
+/// re-openings, re-seeds: each says so in its warning); nothing for a quiet frame.
 void appendFrameEvents(const ScenarioFrameResult& r, std::ostream* out) {
   std::ostringstream line;
   if (r.tempering > 1.0) line << " update tempered x" << r.tempering << ";";
-  if (r.relinearized) line << " restarted from its estimate (re-linearised);";
-  if (r.jump_detected) line << " sudden change detected;";
   for (const std::string& warning : r.warnings) line << " " << warning << ";";
   if (line.tellp() > 0) *out << "frame " << r.frame << ":" << line.str() << "\n";
 }

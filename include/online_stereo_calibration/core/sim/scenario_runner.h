@@ -31,8 +31,6 @@ struct ScenarioFrameResult {
   bool jump_detected = false;
   /// The step's update tempering factor (StepReport::tempering; 1 = untempered).
   double tempering = 1.0;
-  /// The filter was restarted from its estimate (FrameReport::relinearized).
-  bool relinearized = false;
   /// The estimator's warnings for this frame (FrameReport::warnings: restarts, re-openings,
   /// re-seeds, rejected motion), for a run's event log.
   std::vector<std::string> warnings;
