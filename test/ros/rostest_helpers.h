@@ -298,10 +298,10 @@ class RenderedDrive {
   osc::Vector12d truth(int frame) const { return simulator_->truthAt(frame); }
   const osc::DriveSimulator& simulator() const { return *simulator_; }
 
-  /// Publishes the odometry up to two samples past the frame's stamp, then the pair.
-  /// Returns the wall seconds spent rendering.
+  /// Publishes the odometry up to two samples past the frame's stamp (and past it on either
+  /// clock when they differ), then the pair. Returns the wall seconds spent rendering.
   double publish(int frame) {
-    publishOdometryUntil(simulator_->frameStamp(frame) + 0.025);
+    publishOdometryUntil(simulator_->frameStamp(frame) + 0.025 + std::abs(odometry_time_offset_));
     const ros::WallTime start = ros::WallTime::now();
     const osc::SimulatedImagePair pair = simulator_->renderFrame(frame);
     const double render = (ros::WallTime::now() - start).toSec();
@@ -311,12 +311,21 @@ class RenderedDrive {
 
   /// Publishes the odometry samples not yet published with stamps up to @p until (s).
   void publishOdometryUntil(double until) {
-    while (next_odom_ < odometry_.size() && odometry_[next_odom_].stamp <= until) {
-      const osc::StampedPose& sample = odometry_[next_odom_];
-      odom_.publish(osc::bag::toOdometry(sample, simulator_->odometryTwist(sample.stamp), names_));
+    while (next_odom_ < odometry_.size() &&
+           odometry_[next_odom_].stamp - odometry_time_offset_ <= until) {
+      osc::StampedPose sample = odometry_[next_odom_];
+      const osc::Vector6d twist = simulator_->odometryTwist(sample.stamp);
+      sample.stamp -= odometry_time_offset_;
+      odom_.publish(osc::bag::toOdometry(sample, twist, names_));
       ++next_odom_;
     }
   }
+
+  /// From now on the odometry runs on a clock @p offset (s) behind the cameras' (interface.md:
+  /// the time offset is camera clock minus odometry clock): the sample of the vehicle at camera
+  /// time t is stamped t - offset. Stated here on the messages' stamps, independently of the
+  /// simulators' own time_offset, so that a test checks the node's reading of the convention.
+  void setOdometryTimeOffset(double offset) { odometry_time_offset_ = offset; }
 
   /// Publishes @p pair's images and the drive's camera_info, all stamped @p t.
   void publishPair(const osc::SimulatedImagePair& pair, const ros::Time& t) {
@@ -366,6 +375,7 @@ class RenderedDrive {
   std::unique_ptr<osc::DriveSimulator> simulator_;
   std::vector<osc::StampedPose> odometry_;
   size_t next_odom_ = 0;
+  double odometry_time_offset_ = 0.0;  ///< s, camera clock minus odometry clock
   ros::Publisher left_, right_, left_info_, right_info_, odom_;
 };
 
