@@ -137,6 +137,15 @@ void CalibrationDiagnostics::recordEstimate(const osc::CalibrationEstimate& esti
   have_estimate_ = true;
 }
 
+void CalibrationDiagnostics::recordTempering(double factor) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++updates_since_report_;
+  if (factor > 1.0) {
+    ++tempered_since_report_;
+    largest_tempering_ = std::max(largest_tempering_, factor);
+  }
+}
+
 void CalibrationDiagnostics::recordQuality(const osc::CalibrationQuality& quality) {
   std::lock_guard<std::mutex> lock(mutex_);
   quality_ = quality;
@@ -160,6 +169,26 @@ void CalibrationDiagnostics::update() {
     updater_.update();
   }
   last_update_ = now;
+}
+
+/// Tempered updates (core/filter/update_tempering.h): while a start or a re-opening has
+/// little evidence, an update may not shrink any calibration sigma by more than
+/// max_sigma_shrink_per_update; the filter then weighs the update down by a factor. Said,
+/// because the estimate then moves more slowly than the measurements alone would move it.
+void CalibrationDiagnostics::addTempering(diagnostic_updater::DiagnosticStatusWrapper* status,
+                                          std::vector<std::string>* reasons) {
+  std::ostringstream value;
+  value << tempered_since_report_ << " of " << updates_since_report_ << " pairs";
+  if (tempered_since_report_ > 0) {
+    value << " (largest factor " << std::setprecision(3) << largest_tempering_
+          << "): no calibration sigma may shrink more than max_sigma_shrink_per_update in one "
+             "update";
+    reasons->push_back("updates held back (evidence still thin)");
+  }
+  status->add("updates held back since last report", value.str());
+  updates_since_report_ = 0;
+  tempered_since_report_ = 0;
+  largest_tempering_ = 1.0;
 }
 
 void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -236,6 +265,7 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
     status.add("not determined by the motion", undetermined.empty() ? "-" : undetermined);
     if (!undetermined.empty()) reasons.push_back(undetermined);
     addConsistency(estimate_.consistency, &status, &level, &reasons);
+    addTempering(&status, &reasons);
     if (static_cast<int>(estimate_.tracked_points) < config_.min_tracked_points) {
       level = std::max<unsigned char>(level, DiagnosticStatus::WARN);
       reasons.push_back("too few points");

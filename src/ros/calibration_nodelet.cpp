@@ -485,6 +485,7 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
   }
   setQualityFields(quality, &message);
   diagnostics_->recordEstimate(result.estimate, state);
+  diagnostics_->recordTempering(result.estimator.step.tempering);
   if (have_quality) diagnostics_->recordQuality(quality);
   if (!output_->publishCalibration(message, result.estimate)) {
     diagnostics_->recordProblem("non-finite estimate", "estimate not published");

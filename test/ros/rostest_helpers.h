@@ -84,6 +84,17 @@ class DiagnosticsCollector {
     }
     return false;
   }
+  /// Every value of key @p key, in the order the statuses came.
+  std::vector<std::string> values(const std::string& key) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<std::string> out;
+    for (const auto& s : statuses_) {
+      for (const auto& kv : s.values) {
+        if (kv.key == key) out.push_back(kv.value);
+      }
+    }
+    return out;
+  }
   /// Largest value of key @p key read as a number (-1 if never seen).
   double maxValue(const std::string& key) const {
     std::lock_guard<std::mutex> lock(mutex_);

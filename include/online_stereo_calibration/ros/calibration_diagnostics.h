@@ -37,6 +37,10 @@ class CalibrationDiagnostics {
   void recordProblem(const std::string& kind, const std::string& message);
   /// The estimate after a processed pair and its StereoCalibration state.
   void recordEstimate(const osc::CalibrationEstimate& estimate, uint8_t state);
+  /// The factor the pair's filter update was tempered by (osc::StepReport::tempering; 1: not
+  /// held back). Reported per period as "updates held back since last report": how many
+  /// of the period's updates, and the largest factor.
+  void recordTempering(double factor);
   /// The quality figures of the estimate after a processed pair (issue 16), reported as
   /// "rectification error [px]", "depth sigma at 10 m [m]", "depth sigma at 50 m [m]".
   void recordQuality(const osc::CalibrationQuality& quality);
@@ -51,6 +55,9 @@ class CalibrationDiagnostics {
 
  private:
   void produceStatus(diagnostic_updater::DiagnosticStatusWrapper& status);
+  /// "updates held back since last report" and its reason; starts the next period's count.
+  void addTempering(diagnostic_updater::DiagnosticStatusWrapper* status,
+                    std::vector<std::string>* reasons);
 
   /// One kind of problem: how often, the latest message, and the distinct messages since
   /// the last report (so that two problems between two 1 Hz reports are both shown).
@@ -87,6 +94,10 @@ class CalibrationDiagnostics {
   /// ROS time of the last update() call, to see the clock go back.
   ros::Time last_update_;
   int resets_ = 0;
+  /// Filter updates since the last report, how many of them were tempered, the largest factor.
+  int updates_since_report_ = 0;
+  int tempered_since_report_ = 0;
+  double largest_tempering_ = 1.0;
   bool have_estimate_ = false;
   osc::CalibrationEstimate estimate_;
   uint8_t state_ = 0;
