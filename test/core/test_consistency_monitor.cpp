@@ -119,6 +119,39 @@ TEST(ConsistencyScores, EqualTheDenseScoreTest) {
   EXPECT_EQ(s.rest_dof, 4 * u.N - u.G);
 }
 
+// The shift that best explains one update's score, x_caml free: unbiased for a shifted
+// x_camr (5 prior sigmas per axis) and zero for the unshifted x_caml, within 4 standard
+// errors of the draws' scatter.
+TEST(ConsistencyScores, PartialShiftEstimateRecoversTheShiftedBlock) {
+  std::mt19937 rng(17);
+  const SyntheticUpdate u(&rng);
+  VectorXd shift = VectorXd::Zero(u.G);
+  shift.segment<6>(6) = 5.0 * u.P.diagonal().segment<6>(6).cwiseSqrt();
+  const int draws = 400;
+  std::vector<Eigen::Matrix<double, 6, 1>> right, left;
+  for (int k = 0; k < draws; ++k) {
+    const UpdateScores s = u.draw(&rng, shift);
+    right.push_back(partialShiftEstimate(s.score, s.information, ConsistencyBlock::kLeftToRight));
+    left.push_back(partialShiftEstimate(s.score, s.information, ConsistencyBlock::kVehicleToLeft));
+  }
+  const auto check = [&](const std::vector<Eigen::Matrix<double, 6, 1>>& estimates,
+                         const Eigen::Matrix<double, 6, 1>& truth, const char* block) {
+    Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
+    for (const auto& e : estimates) mean += e / draws;
+    Eigen::Matrix<double, 6, 1> variance = Eigen::Matrix<double, 6, 1>::Zero();
+    for (const auto& e : estimates) variance += (e - mean).cwiseAbs2() / (draws - 1);
+    const Eigen::Matrix<double, 6, 1> standard_error = (variance / draws).cwiseSqrt();
+    for (int a = 0; a < 6; ++a) {
+      EXPECT_NEAR(mean(a), truth(a), 4.0 * standard_error(a)) << block << " " << a;
+    }
+    return standard_error;
+  };
+  const Eigen::Matrix<double, 6, 1> error = check(right, shift.segment<6>(6), "x_camr");
+  check(left, Eigen::Matrix<double, 6, 1>::Zero(), "x_caml");
+  // The shift stands far out of the estimates' scatter: an estimator of zero would fail.
+  for (int a = 0; a < 6; ++a) EXPECT_GT(shift(6 + a), 10.0 * error(a)) << a;
+}
+
 FilterConfig monitorConfig() {
   FilterConfig config;
   config.consistency_window = 4.0;

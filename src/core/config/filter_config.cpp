@@ -120,6 +120,13 @@ const std::vector<ParameterSpec>& filterParameterTable() {
       real("jump_settle_time_s", &C::jump_settle_time, 1.0, 0.0, 1e6,
            "time after a block's start or re-opening from which its rotation alone decides "
            "whether a jump can re-open it (a translation the motion cannot tell stays wide)"),
+      real("jump_score_false_alarm", &C::jump_score_false_alarm, 1.0, 0.0, 0.5,
+           "false-alarm probability per update of the test that x_camr's rotation moved beyond "
+           "its covariance (its score statistic, consistency_monitor.h); 0 = off"),
+      integer("jump_score_updates", &C::jump_score_updates, 1, 1000,
+              "updates in a row beyond that bound before x_camr's rotation is widened"),
+      real("jump_score_widening", &C::jump_score_widening, 1.0, 0.1, 100.0,
+           "x_camr's rotation variance grows by (this x the indicated rotation shift)^2 per axis"),
       integer("relinearization_frames", &C::relinearization_frames, 0, 100000,
               "frames between checks whether the estimate left its start (linearisation) "
               "point; 0 = never restart"),
@@ -280,6 +287,7 @@ FilterConfig paperFilterConfig() {
   config.motion_translation_noise = 0.0;      // "not considered in this paper"
   config.motion_excitation_window = 0.0;      // the paper linearises at the measured motion
   config.consistency_window = 0.0;            // the paper's random walk is fixed
+  config.jump_score_false_alarm = 0.0;        // ... and its knocks found by gated points
   config.relinearization_frames = 0;          // the paper's filter runs on from its start
   config.max_sigma_shrink_per_update = 0.0;   // ... and updates as the UKF does
   config.thin_evidence_points = 0;            // ... on any evidence

@@ -257,6 +257,9 @@ FrameReport StereoCalibrationEstimator::processFrame(
       report.dropped = report.step.lost;
       report.dropped.insert(report.dropped.end(), report.step.outliers.begin(),
                             report.step.outliers.end());
+      // Not a re-opening: the points stay, and the re-linearisation check below counts the
+      // frame as any other.
+      if (report.step.right_rotation_widened) report.warnings.push_back(report.step.message);
       if (report.step.jump != JumpBlock::kNone) {
         report.warnings.push_back(report.step.message);
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());

@@ -62,7 +62,37 @@ std::vector<int> indexRange(int first, int count) {
   return r;
 }
 
+/// The pseudo-inverse of a symmetric PSD F with quadraticForm's scaling and rank tolerance.
+Eigen::MatrixXd pseudoInverse(const Eigen::MatrixXd& F) {
+  const int n = static_cast<int>(F.rows());
+  Eigen::VectorXd scale = F.diagonal().cwiseMax(0.0).cwiseSqrt();
+  for (int a = 0; a < n; ++a) scale(a) = scale(a) > 0.0 ? 1.0 / scale(a) : 0.0;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scale.asDiagonal() * F *
+                                                             scale.asDiagonal());
+  const double largest = eigen.eigenvalues().maxCoeff();
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k < n; ++k) {
+    const double lambda = eigen.eigenvalues()(k);
+    if (largest > 0.0 && lambda > 1e-9 * largest) inverse(k) = 1.0 / lambda;
+  }
+  return scale.asDiagonal() *
+         (eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose()) *
+         scale.asDiagonal();
+}
+
 }  // namespace
+
+Eigen::Matrix<double, 6, 1> partialShiftEstimate(const Eigen::Matrix<double, 12, 1>& g,
+                                                 const Eigen::Matrix<double, 12, 12>& F,
+                                                 ConsistencyBlock block) {
+  const int b = block == ConsistencyBlock::kVehicleToLeft ? layout::kCaml : layout::kCamr;
+  const int o = block == ConsistencyBlock::kVehicleToLeft ? layout::kCamr : layout::kCaml;
+  const Eigen::MatrixXd F_bo = F.block<6, 6>(b, o);
+  const Eigen::MatrixXd regression = F_bo * pseudoInverse(F.block<6, 6>(o, o));
+  const Eigen::MatrixXd F_partial = F.block<6, 6>(b, b) - regression * F_bo.transpose();
+  const Eigen::VectorXd g_partial = g.segment<6>(b) - regression * g.segment<6>(o);
+  return pseudoInverse(0.5 * (F_partial + F_partial.transpose())) * g_partial;
+}
 
 const char* consistencyBlockName(ConsistencyBlock block) {
   switch (block) {

@@ -113,6 +113,18 @@ struct FilterConfig {
   /// flat road) never gets below jump_translation_sigma; requiring that as well left an
   /// x_caml yaw step on urban drives undetected (CalibrationFilter::canReopen).
   double jump_settle_time = 5.0;
+  /// x_camr re-opened on evidence (issue 14: a knock is measurements that contradict the
+  /// current x_camr beyond its covariance for some frames in a row). x_camr's partial score
+  /// statistic of one update (consistency_monitor.h; divided by the update's unexplained
+  /// rest per degree of freedom when above 1) beyond the chi-square bound of this false-alarm
+  /// probability in jump_score_updates updates in a row adds (jump_score_widening x the
+  /// rotation shift the update indicates)^2 to x_camr's rotation variances; the points are
+  /// kept. A 0.15 deg knock gates out no point (roll_r 40 sigma off with sigma 0.003 deg)
+  /// and was followed over 30 frames; it is now caught in the first two. A full re-opening
+  /// (jump_rotation_sigma_deg) lost yaw_r, which one update cannot determine. 0 = off.
+  double jump_score_false_alarm = 1e-6;
+  int jump_score_updates = 2;
+  double jump_score_widening = 3.0;
 
   // --- re-linearisation after a start or a re-opening (issue 14) ---
   /// Every this many frames after a start (or a re-opened block), the estimator compares the

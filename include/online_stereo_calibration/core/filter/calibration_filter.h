@@ -73,8 +73,12 @@ struct StepReport {
   std::vector<PointId> outliers;      ///< gated out (Mahalanobis) and removed
   std::vector<PointId> lost;          ///< not measured (or unpredictable) and removed
   JumpBlock jump = JumpBlock::kNone;  ///< a sudden calibration change was detected
-  bool covariance_repaired = false;   ///< the calibration covariance had to be made PD
-  double mean_nis = 0.0;              ///< mean normalised innovation squared of used points (4 dof)
+  /// x_camr's rotation was contradicted by the updates beyond its covariance and its variance
+  /// widened to cover the indicated shift, points kept (FilterConfig::jump_score_*; the
+  /// message says by how much).
+  bool right_rotation_widened = false;
+  bool covariance_repaired = false;  ///< the calibration covariance had to be made PD
+  double mean_nis = 0.0;             ///< mean normalised innovation squared of used points (4 dof)
   /// >= 1: the factor the update's measurement covariances were multiplied by so that no
   /// calibration sigma shrank by more than max_sigma_shrink_per_update (update_tempering.h).
   double tempering = 1.0;
@@ -209,6 +213,10 @@ class CalibrationFilter {
                      std::vector<bool>* failed);
   void marginalizeMotionError(const Eigen::MatrixXd& P_global);
   bool canReopen(JumpBlock block) const;
+  /// After an update: x_camr's score statistic beyond its bound jump_score_updates times in a
+  /// row widens x_camr's rotation variance to cover the indicated shift (FilterConfig::
+  /// jump_score_*). Sets report->right_rotation_widened and its message.
+  void widenRightRotationOnEvidence(StepReport* report);
   /// widenBlock with the config's jump sigmas (the points are the caller's).
   void reopenBlock(JumpBlock block);
   void widenBlock(JumpBlock block, double translation_sigma, double rotation_sigma);
@@ -240,6 +248,8 @@ class CalibrationFilter {
   std::array<double, 2> time_since_opened_ = {0.0, 0.0};
   /// Frames in a row with at least jump_sustained_rejected_fraction of the points gated out.
   int rejection_streak_ = 0;
+  /// Updates in a row whose x_camr score statistic was beyond its bound.
+  int score_streak_ = 0;
   /// No collapse on thin evidence (FilterConfig::thin_evidence_points): the variance floors
   /// of the calibration components started or re-opened (0: none), and the points measured
   /// since; the floors go when there are enough of them.

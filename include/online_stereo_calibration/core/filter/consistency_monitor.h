@@ -90,6 +90,14 @@ void calibrationStatistics(const Eigen::Matrix<double, 12, 1>& score,
                            const Eigen::Matrix<double, 12, 12>& information,
                            std::array<double, 2>* statistic, std::array<int, 2>* dof);
 
+/// The shift of a calibration block (x_caml or x_camr; boxPlus tangent, translation then
+/// rotation) that best explains a score with the other block free:
+/// F_{b|o}^+ g_{b|o}, F_{b|o} = F_bb - F_bo F_oo^+ F_ob, g_{b|o} = g_b - F_bo F_oo^+ g_o.
+/// Its covariance under the model is F_{b|o}^+: directions one update hardly informs are noisy.
+Eigen::Matrix<double, 6, 1> partialShiftEstimate(const Eigen::Matrix<double, 12, 1>& score,
+                                                 const Eigen::Matrix<double, 12, 12>& information,
+                                                 ConsistencyBlock block);
+
 /// The monitor's state, per block (ConsistencyBlock order).
 struct ConsistencyStatus {
   bool enabled = false;  ///< consistency_window_s > 0
