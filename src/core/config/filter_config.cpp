@@ -138,9 +138,6 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "this (1 = as expected)"),
       integer("max_relinearizations", &C::max_relinearizations, 0, 1000,
               "restarts at most after one start or re-opening"),
-      real("relinearization_max_move", &C::relinearization_max_move, 1.0, 0.0, 1e6,
-           "after a start, a block that moved more than this many start sigmas is restarted "
-           "at its start value, not at the estimate (it diverged); 0 = always at the estimate"),
       real("max_sigma_shrink_per_update", &C::max_sigma_shrink_per_update, 1.0, 0.0, 1e6,
            "largest factor by which one update may shrink a calibration sigma; a larger "
            "shrink (a start or re-opening far off) is tempered and spread over frames; "

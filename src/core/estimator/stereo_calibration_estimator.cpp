@@ -114,17 +114,7 @@ bool StereoCalibrationEstimator::relinearizeIfMoved(FrameReport* report) {
   // linearisation point near the truth.
   for (const PointEstimate& p : filter_.points()) report->dropped.push_back(p.id);
   const bool whole_start = anchor_.blocks[0] && anchor_.blocks[1];
-  // A move beyond anything the prior admits is the first updates diverging, not a guess far
-  // off: that block starts again from its start value (after a start of both blocks).
-  const double max_move = config_.relinearization_max_move;
-  const std::array<bool, 2> diverged = {max_move > 0.0 && restart[0] && moved[0] > max_move,
-                                        max_move > 0.0 && restart[1] && moved[1] > max_move};
-  if (whole_start && (diverged[0] || diverged[1])) {
-    StereoExtrinsics start = filter_.extrinsics();
-    if (diverged[0]) start.T_veh_caml = anchor_.extrinsics.T_veh_caml;
-    if (diverged[1]) start.T_caml_camr = anchor_.extrinsics.T_caml_camr;
-    filter_.reset(start, anchor_.covariance);
-  } else if (whole_start && restart[0] && restart[1]) {
+  if (whole_start && restart[0] && restart[1]) {
     filter_.reset(filter_.extrinsics(), anchor_.covariance);
   } else {
     for (int block = 0; block < 2; ++block) {
@@ -143,15 +133,8 @@ bool StereoCalibrationEstimator::relinearizeIfMoved(FrameReport* report) {
   ++anchor_.restarts;
   report->relinearized = true;
   std::ostringstream message;
-  if (whole_start && (diverged[0] || diverged[1])) {
-    message << "restarted from the start value of " << (diverged[0] ? "x_caml" : "x_camr")
-            << (diverged[0] && diverged[1] ? " and x_camr" : "")
-            << " (it moved beyond relinearization_max_move " << max_move
-            << " start sigmas: the first updates diverged), ";
-  } else {
-    message << "restarted from the current estimate (re-linearised): ";
-  }
-  message << (restart[0] && restart[1] ? "x_caml and x_camr"
+  message << "restarted from the current estimate (re-linearised): "
+          << (restart[0] && restart[1] ? "x_caml and x_camr"
               : restart[0]             ? "x_caml"
                                        : "x_camr")
           << " moved " << std::max(restart[0] ? moved[0] : 0.0, restart[1] ? moved[1] : 0.0)

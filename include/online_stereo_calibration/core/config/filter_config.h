@@ -146,12 +146,6 @@ struct FilterConfig {
   double relinearization_nis = 1.05;
   /// ... at most this many times after one start or re-opening.
   int max_relinearizations = 4;
-  /// After a start (of both blocks), a restarting block that moved more than this many start
-  /// sigmas is restarted at its start value, not at the estimate: no guess the prior admits is
-  /// that far off; the first updates diverged (default campaign run 91: yl 18 m, 12 start
-  /// sigmas, in 8 frames after a hand-eye restart, and 10 sigma off for 450 frames when
-  /// restarted there). 0 = always at the estimate.
-  double relinearization_max_move = 6.0;
   /// Largest factor by which one update may shrink a calibration parameter's 1 sigma; an
   /// update that would shrink one more is tempered (its measurement noise scaled up,
   /// update_tempering.h), so that a start or re-opening far from the truth converges over a
