@@ -458,6 +458,9 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
         warning.rfind("x_camr's rotation", 0) == 0) {
       diagnostics_->recordProblem("right camera rotation contradicted", warning);
     }
+    if (result.estimator.too_few_points && warning.rfind("too few points", 0) == 0) {
+      diagnostics_->recordProblem("too few points to update", warning);
+    }
     if (result.estimator.right_rotation_from_stereo_fit &&
         warning.rfind("right camera rotation from the stereo fit", 0) == 0) {
       diagnostics_->recordProblem("right camera rotation from stereo fit", warning);

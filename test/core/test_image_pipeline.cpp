@@ -10,9 +10,11 @@
 #include <cstdlib>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "online_stereo_calibration/core/sim/image_scenario_runner.h"
+#include "online_stereo_calibration/tools/campaign_score.h"
 
 namespace osc {
 namespace {
@@ -99,6 +101,13 @@ TEST(ImagePipeline, DetectsAndFollowsASuddenYawStepOfTheCamera) {
   EXPECT_GE(last.filter.tracked_points, 30);
 }
 
+/// The filter's side of a list of image-level results, for scoreCampaignRun.
+std::vector<ScenarioFrameResult> filterResults(const std::vector<ImageFrameResult>& results) {
+  std::vector<ScenarioFrameResult> filter;
+  for (const ImageFrameResult& r : results) filter.push_back(r.filter);
+  return filter;
+}
+
 /// A calibrated start (no start error, small x_caml sigmas) of the paper drive whose x_camr
 /// parameter `param` (6-11) steps by `step` (m or rad) at frame 100; images as the bags'.
 std::vector<ImageFrameResult> rightCameraStep(
@@ -120,9 +129,12 @@ std::vector<ImageFrameResult> rightCameraStep(
 }
 
 /// A knock of `step` rad on x_camr parameter `param` at frame 100 of a 130-frame calibrated
-/// drive: at least 50 points tracked from frame 105 on, and at frame 129 the parameter within
-/// `tolerance` and 3 sigma. Returns frame 100's result.
-ImageFrameResult expectReconvergedAfterKnock(int param, double step, double tolerance) {
+/// drive: at least 50 points tracked from frame 105 on, at frame 129 the parameter within
+/// `tolerance` and 3 sigma, and from frame 30 on all 12 within 3 sigma in >= 95 % of the
+/// frames, at most `max_frames_beyond_5sigma` beyond 5 sigma (the knock's). Returns frame 100's
+/// result.
+ImageFrameResult expectReconvergedAfterKnock(int param, double step, double tolerance,
+                                             int max_frames_beyond_5sigma = 0) {
   int fewest_from_105 = 1000;
   const std::vector<ImageFrameResult> results =
       rightCameraStep(param, step, 130, [&](const ImageFrameResult& r, const CalibrationPipeline&) {
@@ -138,6 +150,17 @@ ImageFrameResult expectReconvergedAfterKnock(int param, double step, double tole
               fewest_from_105, last.filter.frame, error / kDeg, last.filter.sigmas(param) / kDeg);
   EXPECT_GE(fewest_from_105, 50);
   EXPECT_LT(std::abs(error), tolerance);
+  // Issue 14's bar for all 12 parameters from frame 30 on; a knock the pipeline re-opens in
+  // its own pair is honest in every frame, one within the band is seen a pair later.
+  const CampaignScore score = scoreCampaignRun(filterResults(results));
+  std::printf(
+      "  all 12 within 3 sigma in %.3f of the frames from 30, %d beyond 5 sigma (first: "
+      "frame %d), max z %.2f (%s)\n",
+      score.share_within_3sigma, score.frames_beyond_5sigma, score.first_frame_beyond_5sigma,
+      score.max_z, score.max_z_parameter.c_str());
+  EXPECT_GE(score.share_within_3sigma, 0.95);
+  EXPECT_LE(score.frames_beyond_5sigma, max_frames_beyond_5sigma);
+  if (score.frames_beyond_5sigma > 0) EXPECT_EQ(score.first_frame_beyond_5sigma, 100);
   EXPECT_LT(std::abs(error), 3.0 * last.filter.sigmas(param));
   return results[100];
 }
@@ -149,8 +172,9 @@ ImageFrameResult expectReconvergedAfterKnock(int param, double step, double tole
 // (76 points -> 1) with the narrow band alone; with the trend but no re-opening, pitch_r
 // followed only through x_camr's drift noise, 0.027 deg off 30 frames later, 1 sigma 0.003 deg.
 TEST(ImagePipeline, ReconvergesAfterASmallKnockOfTheRightCamera) {
-  // Measured: within 0.001 deg three frames after the step (1 sigma 0.003 deg at the end).
-  expectReconvergedAfterKnock(10, 0.1 * kDeg, 0.01 * kDeg);
+  // Measured: within 0.001 deg three frames after the step (1 sigma 0.003 deg at the end); the
+  // knock's own pair 30 sigma off (pitch_r), the only frame beyond 5 sigma; 0.99 within 3.
+  expectReconvergedAfterKnock(10, 0.1 * kDeg, 0.01 * kDeg, 1);
 }
 
 // A knock beyond the band of a converged x_camr (0.5 deg of pitch_r: ~5 px off the lines): no
@@ -188,6 +212,79 @@ TEST(ImagePipeline, ReopensTheRightCameraInTheKnocksPairThoughChanceMatchesRemai
   EXPECT_LT(std::abs(knock.filter.parameters(kRollR) - knock.filter.truth(kRollR)),
             3.0 * knock.filter.sigmas(kRollR))
       << "1 sigma " << knock.filter.sigmas(kRollR) / kDeg << " deg";
+}
+
+/// Issue 14's texture-poor stretch: the seed's off-road drive from its start errors, 200
+/// frames, blind in frames 80-149 (7 s at 10 Hz), their images rendered at
+/// `blind_exposure_gain`. Expects no re-opening of x_camr, x_camr within 3 sigma in every
+/// frame from 30 on, all 12 within 3 sigma in >= 95 % of those frames and none beyond 5
+/// sigma, and tracking back after the stretch. Returns the pairs processed in the stretch and
+/// the most stereo pairs the front end found in one of them.
+std::pair<int, int> expectHonestThroughABlindStretch(double blind_exposure_gain) {
+  MeasurementScenario scenario = paperOffroadScenario();
+  scenario.frames = 200;
+  scenario.step_frame = -1;
+  constexpr int kFirstBlind = 80, kLastBlind = 149;
+  scenario.blind_frames = {{kFirstBlind, kLastBlind}};
+  ImageScenarioOptions options;
+  options.blind_exposure_gain = blind_exposure_gain;
+  int reopened = 0, processed_in_stretch = 0, pairs_in_stretch = 0, right_beyond_3sigma = 0;
+  double right_worst_z = 0.0;
+  const std::vector<ImageFrameResult> results = runImageScenario(
+      scenario, FilterConfig(), FrontEndConfig(), options,
+      [&](const ImageFrameResult& r, const CalibrationPipeline&) {
+        const int frame = r.filter.frame;
+        reopened += r.right_camera_reopened;
+        if (scenario.isBlindFrame(frame) && r.processed) {
+          ++processed_in_stretch;
+          pairs_in_stretch = std::max(pairs_in_stretch, r.front_end.stereo_matches);
+        }
+        if (frame < kCampaignFirstScoredFrame) return;
+        const double z = r.filter.tangent_error.tail<6>()
+                             .cwiseQuotient(r.filter.tangent_sigmas.tail<6>())
+                             .cwiseAbs()
+                             .maxCoeff();
+        right_beyond_3sigma += z > 3.0;
+        right_worst_z = std::max(right_worst_z, z);
+        if (frame % 20 == 0 || frame == kLastBlind + 1) {
+          std::printf("  frame %3d: %s, points %3d, x_camr z %.2f, rotation sigma %.4f deg\n",
+                      frame, r.processed ? "processed" : "refused", r.filter.tracked_points, z,
+                      r.filter.tangent_sigmas.tail<3>().maxCoeff() / kDeg);
+        }
+      });
+  EXPECT_EQ(results.size(), 200u);
+  if (results.size() != 200u) return {0, 0};
+  const CampaignScore score = scoreCampaignRun(filterResults(results));
+  std::printf(
+      "  %d pairs of the stretch processed (at most %d stereo matches), re-openings %d; "
+      "all 12 within 3 sigma in %.3f of the frames from 30, %d beyond 5 sigma, max z "
+      "%.2f (%s); x_camr worst z %.2f\n",
+      processed_in_stretch, pairs_in_stretch, reopened, score.share_within_3sigma,
+      score.frames_beyond_5sigma, score.max_z, score.max_z_parameter.c_str(), right_worst_z);
+  EXPECT_EQ(reopened, 0);
+  EXPECT_EQ(right_beyond_3sigma, 0) << "worst " << right_worst_z;
+  EXPECT_GE(score.share_within_3sigma, 0.95);
+  EXPECT_EQ(score.frames_beyond_5sigma, 0)
+      << "max z " << score.max_z << " (" << score.max_z_parameter << ")";
+  EXPECT_GE(results.back().filter.tracked_points, 50);
+  return {processed_in_stretch, pairs_in_stretch};
+}
+
+// Darkness or a uniform wall: the pairs have no contrast and are refused; the next pair
+// brings the motion of the whole 7 s.
+TEST(ImagePipeline, ADarkStretchMidDriveReopensNothingAndStaysHonest) {
+  const std::pair<int, int> stretch = expectHonestThroughABlindStretch(kBlindFrameExposureGain);
+  EXPECT_EQ(stretch.first, 0) << "the dark pairs were not refused";
+}
+
+// A dim, texture-poor view: the pairs are processed but hold (almost) no stereo pair. The
+// filter predicts without updates; the pipeline's whole-image fit finds nothing to contradict
+// x_camr, so the mere absence of matches re-opens nothing (issue 14: "never the mere absence
+// of matches").
+TEST(ImagePipeline, ATexturePoorStretchMidDriveReopensNothingAndStaysHonest) {
+  const std::pair<int, int> stretch = expectHonestThroughABlindStretch(0.1);
+  EXPECT_GE(stretch.first, 60) << "the dim pairs were refused";
+  EXPECT_LE(stretch.second, 5) << "the dim pairs were not texture-poor";
 }
 
 /// Diagnostics: rightCameraStep with D_PARAM (6-11, default 10 = pitch_r), D_STEP (deg or m,

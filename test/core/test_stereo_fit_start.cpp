@@ -189,6 +189,24 @@ TEST(StereoFitStart, RightCameraWhoseBandHoldsNoMatchIsReseededThoughWithinItsSi
   EXPECT_EQ(run.beyond, 0) << "worst " << run.worst;
 }
 
+// Issue 14: the baseline guessed 50 % long (yr -0.45 m for -0.30), with the seed's other start
+// errors (x_caml 0.5 m / 10 deg per axis off). The fit agrees with x_camr's rotation (the
+// guess's angles are exact), so nothing is re-seeded; the length comes from the motion. From
+// frame 30 on all 12 errors within 3 sigma in >= 95 % of the frames and none beyond 5 sigma.
+// (50 % short, -0.15 m, is open: no point is ever initialised, docs/RESULTS.md "Session 19".)
+TEST(StereoFitStart, BaselineGuessedHalfLongIsHonestFromFrame30) {
+  Vector12d error = paperOffroadScenario().initial_error;
+  error(7) = -0.15;
+  const StartRun run = runStart(error, 120, 1);
+  std::cout << "baseline 50 % long: from frame 30 all 12 within 3 sigma in " << run.within << " of "
+            << run.frames << ", beyond 5 sigma in " << run.beyond << ", worst " << run.worst
+            << "; x_camr at the end " << 1e3 * run.last_translation_error << " mm\n";
+  EXPECT_EQ(run.reseeded_at, -1);
+  EXPECT_GE(run.within, 0.95 * run.frames);
+  EXPECT_EQ(run.beyond, 0) << "worst " << run.worst;
+  EXPECT_LT(run.last_translation_error, 0.005);
+}
+
 // The figures of docs/RESULTS.md "Stereo fit at start": image-level starts with x_camr's
 // angles 5 deg off and the baseline 50 % short and long (the seed's other start errors),
 // seeds 1-3, with the fit at start off and on. Run with --gtest_also_run_disabled_tests;

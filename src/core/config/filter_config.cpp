@@ -149,6 +149,10 @@ const std::vector<ParameterSpec>& filterParameterTable() {
       real("thin_evidence_max_shrink", &C::thin_evidence_max_shrink, 1.0, 1.0, 1e6,
            "how far below its start value a sigma may fall on thin evidence (see "
            "thin_evidence_points)"),
+      integer("min_points_to_update", &C::min_points_to_update, 0, 100000,
+              "a pair with fewer stereo pairs than this (tracked and new) does not update the "
+              "calibration (the filter predicts; its points start afresh); 0 = update on any "
+              "point"),
       real("initial_time_offset_ms", &C::initial_time_offset, 1e-3, -1000.0, 1000.0,
            "prior mean of the camera clock minus the odometry clock (the odometry's sample "
            "stamped t holds the vehicle at camera time t + offset; a late-stamping odometry "
@@ -291,6 +295,7 @@ FilterConfig paperFilterConfig() {
   config.relinearization_frames = 0;          // the paper's filter runs on from its start
   config.max_sigma_shrink_per_update = 0.0;   // ... and updates as the UKF does
   config.thin_evidence_points = 0;            // ... on any evidence
+  config.min_points_to_update = 0;            // ... however few points
   config.initial_time_offset_sigma = 0.0;     // the paper takes the odometry as synchronised
   config.odometry_scale_sigma = 0.0;          // ... and exact in scale
   config.odometry_velocity_bias_sigma = 0.0;  // ... and without a velocity error

@@ -132,9 +132,9 @@ std::vector<ImageFrameResult> runImageScenario(
     std::mt19937 exposure_rng(render.noise_seed);
     std::uniform_real_distribution<double> flicker(1.0 - options.exposure_variation,
                                                    1.0 + options.exposure_variation);
-    // A blind frame is rendered almost black (only the noise remains to see).
+    // A blind frame is rendered almost black (only the noise remains to see) or dim.
     const double gain =
-        options.render.exposure_gain * (frame.blind ? kBlindFrameExposureGain : 1.0);
+        options.render.exposure_gain * (frame.blind ? options.blind_exposure_gain : 1.0);
     render.exposure_gain = gain * flicker(exposure_rng);
     const cv::Mat left = renderer.render(left_camera, T_world_lopt, render);
     render.noise_seed += 1u;
@@ -154,6 +154,7 @@ std::vector<ImageFrameResult> runImageScenario(
     r.front_end = result.front_end;
     if (result.stereo_fit_tried) r.stereo_fit = result.stereo_fit;
     r.right_rotation_from_stereo_fit = result.estimator.right_rotation_from_stereo_fit;
+    r.right_camera_reopened = result.right_camera_reopened;
     since_processed.reset();
     if (!result.processed) {
       // Nothing to check: the front end's lists are still the last processed pair's.

@@ -73,6 +73,10 @@ struct FrameReport {
   /// re-opening (CalibrationPipeline, FilterConfig::stereo_fit_start; the warning names the
   /// old and new angles and the distance); tracks reset.
   bool right_rotation_from_stereo_fit = false;
+  /// Fewer stereo pairs (tracked and new) than FilterConfig::min_points_to_update: the
+  /// calibration was predicted, not updated, and the tracked points start afresh (the
+  /// warning is given in the first such pair of a stretch).
+  bool too_few_points = false;
   std::vector<std::string> warnings;  ///< human-readable, one per problem
 };
 
@@ -191,6 +195,8 @@ class StereoCalibrationEstimator {
   CameraModel right_;
   CalibrationFilter filter_;
   bool has_previous_frame_ = false;
+  /// The last pair had too few tracked points to update (FrameReport::too_few_points).
+  bool held_for_few_points_ = false;
   LinearizationAnchor anchor_;
   /// The last start's guess and its tangent covariance (restartFromMotion starts from them).
   StereoExtrinsics guess_;

@@ -29,6 +29,10 @@ struct ImageScenarioOptions {
   /// drawn uniformly from [1 - v, 1 + v], independently per frame and camera (seeded by the
   /// frame index, so a run is reproducible). 0 = every image as render says.
   double exposure_variation = 0.0;
+  /// Exposure gain of the images of a blind frame (MeasurementScenario::blind_frames). The
+  /// default renders them almost black, and the pipeline refuses them (no contrast); a gain of
+  /// ~0.1 keeps a little contrast, so the pairs are processed but show (almost) no feature.
+  double blind_exposure_gain = kBlindFrameExposureGain;
   /// A match or track is correct within this distance (px) of the true projection.
   double correct_tolerance = 1.5;
   /// Check the correctness of every stereo match (before bucketing), not only of the
@@ -66,6 +70,8 @@ struct ImageFrameResult {
   /// (PipelineResult::stereo_fit), and whether x_camr's rotation was re-seeded from it.
   std::optional<RightRotationSeed> stereo_fit;
   bool right_rotation_from_stereo_fit = false;
+  /// The pipeline re-opened x_camr's rotation in this pair (PipelineResult::right_camera_reopened).
+  bool right_camera_reopened = false;
 };
 
 /// What the scene says about a stereo pair (left_pixel, right_pixel).
