@@ -249,7 +249,7 @@ TEST(Start, NoPointAtAllIsExplainedByTheBaseline) {
 // min_points_to_update (5) of them is predicted, not updated: the calibration comes out as
 // from a pair without any point, the estimator says so once per stretch, and those points
 // start afresh as new ones. With the rule off, the same 3 points do move the calibration.
-TEST(FewPoints, APairWithFewerTrackedPointsThanTheMinimumIsPredictedNotUpdated) {
+TEST(FewPoints, APairWithFewerStereoPairsThanTheMinimumIsPredictedNotUpdated) {
   MeasurementScenario scenario = paperOffroadScenario();
   scenario.frames = 46;
   scenario.step_frame = -1;
@@ -290,9 +290,9 @@ TEST(FewPoints, APairWithFewerTrackedPointsThanTheMinimumIsPredictedNotUpdated) 
     const FrameReport a = held.processFrame(frame.measured_motion, seen);
     updated.processFrame(frame.measured_motion, seen);
     simulator.dropTracks(a.dropped);
-    if (frame.index < 40 || frame.index > 42) {
-      EXPECT_FALSE(a.too_few_points) << "frame " << frame.index;
-    }
+    // Frame 42 tracks only the 3 restarted points, but its pair holds many new ones: it is
+    // updated (few tracked of many pairs is a start's thin evidence, not a texture-poor view).
+    EXPECT_FALSE(a.too_few_points) << "frame " << frame.index;
   }
   EXPECT_EQ(warnings.find("too few points: 3 stereo pairs, fewer than min_points_to_update 5"), 0u)
       << warnings;

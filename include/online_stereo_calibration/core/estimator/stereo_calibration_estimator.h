@@ -195,7 +195,7 @@ class StereoCalibrationEstimator {
   CameraModel right_;
   CalibrationFilter filter_;
   bool has_previous_frame_ = false;
-  /// The last pair had too few tracked points to update (FrameReport::too_few_points).
+  /// The last pair had too few stereo pairs to update (FrameReport::too_few_points).
   bool held_for_few_points_ = false;
   LinearizationAnchor anchor_;
   /// The last start's guess and its tangent covariance (restartFromMotion starts from them).
