@@ -461,6 +461,10 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
     if (result.estimator.too_few_points && warning.rfind("too few points", 0) == 0) {
       diagnostics_->recordProblem("too few points to update", warning);
     }
+    if (result.estimator.baseline_from_motion &&
+        warning.rfind("baseline length from motion", 0) == 0) {
+      diagnostics_->recordProblem("baseline length from motion", warning);
+    }
     if (result.estimator.right_rotation_from_stereo_fit &&
         warning.rfind("right camera rotation from the stereo fit", 0) == 0) {
       diagnostics_->recordProblem("right camera rotation from stereo fit", warning);

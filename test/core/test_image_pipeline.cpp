@@ -160,7 +160,9 @@ ImageFrameResult expectReconvergedAfterKnock(int param, double step, double tole
       score.max_z, score.max_z_parameter.c_str());
   EXPECT_GE(score.share_within_3sigma, 0.95);
   EXPECT_LE(score.frames_beyond_5sigma, max_frames_beyond_5sigma);
-  if (score.frames_beyond_5sigma > 0) EXPECT_EQ(score.first_frame_beyond_5sigma, 100);
+  if (score.frames_beyond_5sigma > 0) {
+    EXPECT_EQ(score.first_frame_beyond_5sigma, 100);
+  }
   EXPECT_LT(std::abs(error), 3.0 * last.filter.sigmas(param));
   return results[100];
 }

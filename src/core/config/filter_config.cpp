@@ -153,6 +153,10 @@ const std::vector<ParameterSpec>& filterParameterTable() {
               "a pair with fewer stereo pairs than this (tracked and new) does not update the "
               "calibration (the filter predicts; its points start afresh); 0 = update on any "
               "point"),
+      integer("baseline_from_motion", &C::baseline_from_motion, 0, 1,
+              "while no point can be initialised (a baseline guess far off), measure the "
+              "baseline's length from the left camera's motion at the odometry's scale and "
+              "restart x_camr's translation from it; 0 = off"),
       real("initial_time_offset_ms", &C::initial_time_offset, 1e-3, -1000.0, 1000.0,
            "prior mean of the camera clock minus the odometry clock (the odometry's sample "
            "stamped t holds the vehicle at camera time t + offset; a late-stamping odometry "
@@ -296,6 +300,7 @@ FilterConfig paperFilterConfig() {
   config.max_sigma_shrink_per_update = 0.0;   // ... and updates as the UKF does
   config.thin_evidence_points = 0;            // ... on any evidence
   config.min_points_to_update = 0;            // ... however few points
+  config.baseline_from_motion = 0;            // ... and the baseline from its points alone
   config.initial_time_offset_sigma = 0.0;     // the paper takes the odometry as synchronised
   config.odometry_scale_sigma = 0.0;          // ... and exact in scale
   config.odometry_velocity_bias_sigma = 0.0;  // ... and without a velocity error

@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include "online_stereo_calibration/core/filter/state_layout.h"
+#include "online_stereo_calibration/core/geometry/pose.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
 
 namespace osc {
@@ -14,12 +15,27 @@ namespace {
 
 /// Fewest refused stereo pairs for which "no point could be initialised" is worth a warning.
 constexpr int kFewestPairsToExplain = 10;
+/// The baseline's length from motion restarts x_camr only while the length's 1 sigma is above
+/// this share of it (a 0.3 m rig: 9 cm; the guess's sigma points then reach below half the
+/// length). Measured on the default campaign: without it, run 90 (its points kept out by x_caml
+/// 20 deg off) was restarted at the right length with x_camr's wrong rotation, 570 frames
+/// beyond 5 sigma.
+constexpr double kUnknownLengthShare = 0.3;
+/// The least 1 sigma of a length from motion, as a share of it (the fit's own sigma is doubled).
+constexpr double kLeastLengthSigma = 0.05;
 
 StereoIntrinsics stereoIntrinsics(const CameraModel& left, const CameraModel& right) {
   StereoIntrinsics k;
   k.K_left = left.K();
   k.K_right = right.K();
   return k;
+}
+
+BaselineFromMotionConfig baselineConfig(const FilterConfig& config, const CameraModel& left) {
+  BaselineFromMotionConfig b;
+  b.pixel_noise = config.pixel_noise;
+  b.motion.focal = left.K()(0, 0);
+  return b;
 }
 
 HandEyeRotationConfig handEyeConfig(const FilterConfig& config) {
@@ -41,7 +57,8 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
       right_(right),
       filter_(config, stereoIntrinsics(left_, right_)),
       guess_(initial_guess),
-      mounting_(left_, handEyeConfig(config)) {
+      mounting_(left_, handEyeConfig(config)),
+      baseline_from_motion_(baselineConfig(config, left_)) {
   filter_.reset(initial_guess);
   guess_covariance_ = filter_.covariance();
   anchorHere(JumpBlock::kNone, 0.0, 0.0);
@@ -229,6 +246,7 @@ FrameReport StereoCalibrationEstimator::processFrame(
   if (handEyeActive() && restartFromMotion(motion, observations, &report)) {
     has_previous_frame_ = false;  // tracking starts afresh with this pair, as after a start
   }
+  const bool follows_previous_pair = has_previous_frame_;
   std::vector<PointMeasurement> tracked, candidates;
   for (const StereoObservation& o : observations) {
     PointMeasurement m;
@@ -310,9 +328,10 @@ FrameReport StereoCalibrationEstimator::processFrame(
   }
   // Stereo pairs but not one point: the filter cannot learn anything (issue 14: an 11 cm rig
   // guessed at 1 cm stayed at 0 points for 800 frames with no other sign). Say why.
-  if (filter_.pointCount() == 0 && report.rejected_new_points >= kFewestPairsToExplain &&
-      report.new_points == 0) {
-    report.no_point_initialised = true;
+  report.no_point_initialised = filter_.pointCount() == 0 &&
+                                report.rejected_new_points >= kFewestPairsToExplain &&
+                                report.new_points == 0;
+  if (report.no_point_initialised) {
     const CalibrationEstimate e = estimate();
     std::ostringstream message;
     message << "no point could be initialised: none of " << report.rejected_new_points
@@ -320,7 +339,19 @@ FrameReport StereoCalibrationEstimator::processFrame(
             << config_.max_point_depth << "] m with the current left->right estimate "
             << "(baseline yr " << e.parameters(7) << " m, 1 sigma " << e.sigmas()(7)
             << " m); check the baseline guess and initial_camr_translation_sigma_m";
+    if (config_.baseline_from_motion != 0) {
+      const BaselineLength length = baseline_from_motion_.estimate();
+      message << "; measuring the baseline's length from the left camera's motion ("
+              << (length.valid ? "so far " + std::to_string(length.length) + " m" : length.why)
+              << ")";
+    }
     report.warnings.push_back(message.str());
+  }
+  if (config_.baseline_from_motion != 0 && report.no_point_initialised) {
+    report.baseline_from_motion = learnBaselineLength(
+        motion, follows_previous_pair && !report.motion_rejected, candidates, &report);
+  } else {
+    forgetBaselineEvidence();
   }
   // A point re-initialised from this pair (after a jump or a motion reset) is not dropped.
   std::vector<PointId> still_dropped;
@@ -329,6 +360,102 @@ FrameReport StereoCalibrationEstimator::processFrame(
   }
   report.dropped.swap(still_dropped);
   return report;
+}
+
+void StereoCalibrationEstimator::forgetBaselineEvidence() {
+  baseline_from_motion_.clear();
+  previous_candidates_.clear();
+  given_links_.clear();
+}
+
+bool StereoCalibrationEstimator::learnBaselineLength(
+    const MotionIncrement& motion, bool motion_links_pairs,
+    const std::vector<PointMeasurement>& candidates, FrameReport* report) {
+  const Eigen::Matrix3d K_left_inverse = left_.K().inverse(),
+                        K_right_inverse = right_.K().inverse();
+  const auto normalised = [&](const PointMeasurement& m) {
+    Eigen::Vector4d n;
+    n << (K_left_inverse * m.z.head<2>().homogeneous()).head<2>(),
+        (K_right_inverse * m.z.tail<2>().homogeneous()).head<2>();
+    return n;
+  };
+  std::unordered_map<PointId, Eigen::Vector4d> current;
+  std::vector<StereoLink> links;
+  for (const PointMeasurement& m : candidates) {
+    current[m.id] = normalised(m);
+    const auto previous = previous_candidates_.find(m.id);
+    if (given_links_.empty() && previous != previous_candidates_.end())
+      links.push_back({previous->second, current[m.id]});
+  }
+  for (const auto& [previous, now] : given_links_) {
+    PointMeasurement a, b;
+    if (toMeasurement(previous, &a) && toMeasurement(now, &b))
+      links.push_back({normalised(a), normalised(b)});
+  }
+  previous_candidates_.swap(current);
+  given_links_.clear();
+  if (!motion_links_pairs || links.empty()) return false;
+  // The left camera's motion between the pairs, at the odometry's scale (its length hardly
+  // depends on x_caml: only through the lever arm of the vehicle's rotation).
+  const Eigen::Isometry3d& T_veh_caml = filter_.extrinsics().T_veh_caml;
+  const double moved =
+      (T_veh_caml.inverse() * motion.T_prev_curr * T_veh_caml).translation().norm();
+  baseline_from_motion_.addPair(links, filter_.extrinsics().leftToRightOptical(), moved);
+  const BaselineLength length = baseline_from_motion_.estimate();
+  if (!length.valid) return false;
+  forgetBaselineEvidence();
+  // The seed's sigma: twice the fit's (the pairs' motion fits err in common, which the
+  // per-point sigmas do not see) and at least 5 % of the length.
+  const double sigma = std::max(2.0 * length.sigma, kLeastLengthSigma * length.length);
+  using namespace layout;
+  const Eigen::Vector3d t = filter_.extrinsics().T_caml_camr.translation();
+  const double old_length = t.norm();
+  if (!(old_length > 0.0)) return false;  // no direction to put the length along
+  const Matrix12d P = filter_.covariance();
+  const Eigen::Vector3d c = t / old_length;
+  const double old_sigma =
+      std::sqrt(c.dot(P.block<3, 3>(kCamr + kTranslation, kCamr + kTranslation) * c));
+  // Only a length the filter does not know: then its sigma points reach almost no baseline and
+  // no point passes the depth check. With a length it knows, the points are kept out by
+  // something else (x_caml or x_camr's rotation far off; default campaign run 90), which a
+  // restart of x_camr from the current estimate would lock in.
+  if (!(old_sigma > kUnknownLengthShare * old_length) || !(sigma < 0.5 * old_sigma)) return false;
+  // The length along the baseline's direction; across it the direction's uncertainty at the
+  // new length; the rotation's covariance kept.
+  const double ratio = length.length / old_length;
+  const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - c * c.transpose();
+  Matrix6d block = P.block<6, 6>(kCamr, kCamr);
+  block.topLeftCorner<3, 3>() = ratio * ratio * across * block.topLeftCorner<3, 3>() * across +
+                                sigma * sigma * c * c.transpose();
+  block.topRightCorner<3, 3>() = ratio * across * block.topRightCorner<3, 3>();
+  block.bottomLeftCorner<3, 3>() = block.topRightCorner<3, 3>().transpose();
+  Eigen::Isometry3d T_caml_camr = filter_.extrinsics().T_caml_camr;
+  T_caml_camr.translation() = length.length * c;
+  // The offset is x_camr's rotation about the axis across the baseline and the view being off
+  // (yaw_r for a horizontal rig; the stereo fit at a start hardly determines it): re-centred
+  // when significant, its sigma kept (the filter linearises near the truth, and nothing it
+  // did not learn is claimed).
+  const bool turned = std::abs(length.offset) > 3.0 * length.offset_sigma;
+  if (turned) {
+    const Eigen::Matrix3d& R_bo = rotationBodyOptical();
+    const Eigen::Isometry3d T_lopt_ropt =
+        withoutDisparityOffset(filter_.extrinsics().leftToRightOptical(), length.offset);
+    T_caml_camr.linear() = R_bo * T_lopt_ropt.linear() * R_bo.transpose();
+  }
+  for (PointId id : reseedRightCamera(T_caml_camr, block, true)) report->dropped.push_back(id);
+  std::ostringstream message;
+  message.precision(3);
+  message << "baseline length from motion: x_camr's translation restarted at " << length.length
+          << " m, 1 sigma " << sigma << " m (was " << old_length << " m, 1 sigma " << old_sigma
+          << " m; " << length.inliers << " points in " << length.pairs
+          << " pairs of the left camera's motion)";
+  message << "; disparity offset " << length.offset * 180.0 / M_PI << " deg, 1 sigma "
+          << length.offset_sigma * 180.0 / M_PI << " deg"
+          << (turned ? ": x_camr turned by it about the axis across the baseline and the view"
+                     : "");
+  message << "; tracks reset";
+  report->warnings.push_back(message.str());
+  return true;
 }
 
 std::vector<PointId> StereoCalibrationEstimator::resetTracking() {
@@ -370,6 +497,7 @@ std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
   filter_.reset(seeded, withRightCamera(filter_.covariance(), covariance));
   guess_.T_caml_camr = T_caml_camr;
   guess_covariance_ = withRightCamera(Matrix12d(guess_covariance_), covariance);
+  forgetBaselineEvidence();  // its disparities were measured with the old x_camr
   has_previous_frame_ = false;
   mounting_.forgetFrame();
   if (start) {
@@ -383,6 +511,8 @@ std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
   guess_ = guess;
+  forgetBaselineEvidence();
+  held_for_few_points_ = false;
   mounting_.clear();
   filter_.reset(guess);
   guess_covariance_ = filter_.covariance();
@@ -393,6 +523,8 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
                                        const Matrix12d& tangent_covariance) {
   guess_ = guess;
+  forgetBaselineEvidence();
+  held_for_few_points_ = false;
   mounting_.clear();
   // The given covariance is one as estimate() reports it (a saved calibration): take out what
   // the odometry's scale adds there, so that save -> restore -> estimate() gives it back. If

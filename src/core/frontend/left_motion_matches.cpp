@@ -13,6 +13,30 @@ constexpr size_t kMaxKeypoints = 500;
 
 }  // namespace
 
+std::vector<std::pair<int, int>> matchDescriptors(const cv::Mat& previous, const cv::Mat& current,
+                                                  bool binary, double ratio) {
+  std::vector<std::pair<int, int>> matches;
+  if (previous.rows < 1 || current.rows < 1 || previous.type() != current.type() ||
+      previous.cols != current.cols) {
+    return matches;
+  }
+  cv::BFMatcher matcher(binary ? cv::NORM_HAMMING : cv::NORM_L2);
+  std::vector<std::vector<cv::DMatch>> forward, backward;
+  matcher.knnMatch(previous, current, forward, 2);
+  matcher.knnMatch(current, previous, backward, 2);
+  auto unambiguous = [ratio](const std::vector<cv::DMatch>& m) {
+    return m.size() == 2 ? m[0].distance < ratio * m[1].distance : m.size() == 1;
+  };
+  for (const std::vector<cv::DMatch>& m : forward) {
+    if (m.empty() || !unambiguous(m)) continue;
+    const int i = m[0].queryIdx, j = m[0].trainIdx;
+    const std::vector<cv::DMatch>& back = backward[static_cast<size_t>(j)];
+    if (back.empty() || back[0].trainIdx != i || !unambiguous(back)) continue;
+    matches.emplace_back(i, j);
+  }
+  return matches;
+}
+
 void matchLeftFeatures(const FeatureSet& previous, const FeatureSet& current,
                        const CameraModel& left, double ratio,
                        std::vector<Eigen::Vector2d>* previous_normalized,
@@ -46,19 +70,10 @@ void matchLeftFeatures(const FeatureSet& previous, const FeatureSet& current,
   cv::Mat previous_descriptors, current_descriptors;
   strongest(previous, &previous_index, &previous_descriptors);
   strongest(current, &current_index, &current_descriptors);
-  cv::BFMatcher matcher(previous.binary ? cv::NORM_HAMMING : cv::NORM_L2);
-  std::vector<std::vector<cv::DMatch>> forward, backward;
-  matcher.knnMatch(previous_descriptors, current_descriptors, forward, 2);
-  matcher.knnMatch(current_descriptors, previous_descriptors, backward, 2);
-  auto unambiguous = [ratio](const std::vector<cv::DMatch>& m) {
-    return m.size() == 2 ? m[0].distance < ratio * m[1].distance : m.size() == 1;
-  };
+  const std::vector<std::pair<int, int>> matches =
+      matchDescriptors(previous_descriptors, current_descriptors, previous.binary, ratio);
   const Eigen::Matrix3d K_inv = left.K().inverse();
-  for (const std::vector<cv::DMatch>& m : forward) {
-    if (m.empty() || !unambiguous(m)) continue;
-    const int i = m[0].queryIdx, j = m[0].trainIdx;
-    const std::vector<cv::DMatch>& back = backward[static_cast<size_t>(j)];
-    if (back.empty() || back[0].trainIdx != i || !unambiguous(back)) continue;
+  for (const auto& [i, j] : matches) {
     const size_t a = static_cast<size_t>(previous_index[static_cast<size_t>(i)]);
     const size_t b = static_cast<size_t>(current_index[static_cast<size_t>(j)]);
     previous_normalized->push_back((K_inv * previous.undistorted[a].homogeneous()).hnormalized());

@@ -113,6 +113,7 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   last_tracked_.clear();
   last_new_.clear();
   last_matches_.clear();
+  last_match_keypoints_.clear();
   last_windows_.clear();
   last_bands_.clear();
   pending_.clear();
@@ -420,6 +421,7 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
     if (!onTrend(trend, pair)) continue;
     const Eigen::Vector2d& pl = pair.left_raw;
     last_matches_.push_back(observation(0, pl, pair.right_raw));
+    last_match_keypoints_.push_back(matches[static_cast<size_t>(pair.match)].left);
     near.clear();
     const Eigen::Vector2d r = Eigen::Vector2d::Constant(config_.min_distance_to_track);
     tracked_grid.query(pl - r, pl + r, &near);
@@ -533,6 +535,12 @@ StereoFrontEnd::EpipolarBand StereoFrontEnd::bandPolylines(const Eigen::Vector2d
     }
   }
   return band;
+}
+
+cv::Mat StereoFrontEnd::lastStereoMatchDescriptors() const {
+  cv::Mat rows;
+  for (int k : last_match_keypoints_) rows.push_back(left_features_.descriptors.row(k));
+  return rows;
 }
 
 void StereoFrontEnd::commit(const FrameReport& report, const CalibrationFilter& filter) {

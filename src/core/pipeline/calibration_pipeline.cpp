@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/frontend/feature_detection.h"
@@ -81,8 +82,10 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
     }
     result.stereo_fit = last_seed_;
   }
+  linkStereoMatchesToPreviousPair();
   result.estimator = estimator_->processFrame(motion_since_last_processed, result.stereo_pairs);
   front_end_->commit(result.estimator, estimator_->filter());
+  keepStereoMatchesForTheNextPair();
   feedHandEye(motion_since_last_processed);
   if (!seeded.empty()) {
     result.estimator.right_rotation_from_stereo_fit = true;
@@ -127,6 +130,30 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   result.processing_time =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+void CalibrationPipeline::linkStereoMatchesToPreviousPair() {
+  constexpr double kRatio = 0.8;  // Lowe's ratio test
+  if (!estimator_->wantsStereoLinks() || previous_stereo_matches_.empty()) return;
+  const std::vector<StereoObservation>& matches = front_end_->lastStereoMatches();
+  std::vector<std::pair<StereoObservation, StereoObservation>> links;
+  for (const auto& [i, j] : matchDescriptors(previous_stereo_match_descriptors_,
+                                             front_end_->lastStereoMatchDescriptors(),
+                                             front_end_->lastLeftFeatures().binary, kRatio)) {
+    links.emplace_back(previous_stereo_matches_[static_cast<size_t>(i)],
+                       matches[static_cast<size_t>(j)]);
+  }
+  estimator_->linkStereoMatches(std::move(links));
+}
+
+void CalibrationPipeline::keepStereoMatchesForTheNextPair() {
+  if (estimator_->wantsStereoLinks()) {
+    previous_stereo_matches_ = front_end_->lastStereoMatches();
+    previous_stereo_match_descriptors_ = front_end_->lastStereoMatchDescriptors();
+  } else {
+    previous_stereo_matches_.clear();
+    previous_stereo_match_descriptors_.release();
+  }
 }
 
 void CalibrationPipeline::feedHandEye(const MotionIncrement& motion) {

@@ -174,6 +174,12 @@ struct FilterConfig {
   /// them, roll_l walked from 1.9 to 3.5 sigma off while its sigma shrank 6 %; held, it stayed
   /// within 2.3 sigma (docs/RESULTS.md "Session 19"). 0 = update on any point (the paper).
   int min_points_to_update = 5;
+  /// While stereo pairs come but not one point can be initialised (a baseline prior as wide
+  /// as a good part of its guess: 0.15 +- 0.1 m for a 0.3 m rig gives sigma points with
+  /// nearly no baseline), measure the baseline's length from the left camera's motion at the
+  /// odometry's scale (baseline_from_motion.h) and restart x_camr's translation from it
+  /// (issue 14: "a guess 50 % off must converge"). 0 = off (the paper).
+  int baseline_from_motion = 1;
 
   // --- the odometry's own errors as states (issue 15; process_model.h correctedMotion) ---
   /// Prior mean (s) of the camera-odometry time offset d: the camera clock minus the

@@ -9,9 +9,12 @@
 
 #include <array>
 #include <string>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "online_stereo_calibration/core/config/filter_config.h"
+#include "online_stereo_calibration/core/estimator/baseline_from_motion.h"
 #include "online_stereo_calibration/core/estimator/mounting_from_motion.h"
 #include "online_stereo_calibration/core/estimator/types.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
@@ -77,6 +80,10 @@ struct FrameReport {
   /// calibration was predicted, not updated, and the tracked points start afresh (the
   /// warning is given in the first such pair of a stretch).
   bool too_few_points = false;
+  /// x_camr's translation was restarted with the baseline's length measured from the left
+  /// camera's motion (FilterConfig::baseline_from_motion; no point could be initialised with
+  /// the guess's; the warning names the old and new length); tracks reset.
+  bool baseline_from_motion = false;
   std::vector<std::string> warnings;  ///< human-readable, one per problem
 };
 
@@ -137,6 +144,17 @@ class StereoCalibrationEstimator {
   void addLeftCameraMatches(const MotionIncrement& motion,
                             const std::vector<Eigen::Vector2d>& previous,
                             const std::vector<Eigen::Vector2d>& current);
+  /// The same points in the previous and the next processFrame's pair (previous, current;
+  /// raw pixels, ids ignored): for the baseline's length from motion
+  /// (FilterConfig::baseline_from_motion) from a front end that does not track the pairs the
+  /// filter refused (CalibrationPipeline matches them by their left descriptors). Without
+  /// them, the candidates seen with the same id in both pairs are linked.
+  void linkStereoMatches(std::vector<std::pair<StereoObservation, StereoObservation>> links) {
+    given_links_ = std::move(links);
+  }
+  /// The baseline's length from motion wants linkStereoMatches for the next pair: no point
+  /// could be initialised in the last one.
+  bool wantsStereoLinks() const { return !previous_candidates_.empty(); }
   /// The hand-eye start is still collecting (on, rotation not yet determined).
   bool handEyeActive() const { return config_.hand_eye_start != 0 && !mounting_.done(); }
   /// The hand-eye start's pairs and solver (FilterConfig::hand_eye_start).
@@ -190,6 +208,15 @@ class StereoCalibrationEstimator {
   bool restartFromMotion(const MotionIncrement& motion,
                          const std::vector<StereoObservation>& observations, FrameReport* report);
 
+  /// While no point can be initialised: links this pair's candidates to the previous pair's
+  /// and, once the baseline's length from motion is known well enough, restarts x_camr's
+  /// translation with it (FilterConfig::baseline_from_motion). True if it did.
+  /// @p motion_links_pairs: the motion is the one since the last pair processed (not the
+  /// first pair after a start or a reset).
+  bool learnBaselineLength(const MotionIncrement& motion, bool motion_links_pairs,
+                           const std::vector<PointMeasurement>& candidates, FrameReport* report);
+  void forgetBaselineEvidence();
+
   FilterConfig config_;
   CameraModel left_;
   CameraModel right_;
@@ -202,6 +229,11 @@ class StereoCalibrationEstimator {
   StereoExtrinsics guess_;
   Eigen::MatrixXd guess_covariance_;
   MountingFromMotion mounting_;
+  /// The baseline's length from motion (learnBaselineLength) and the last pair's candidates
+  /// (undistorted pixels) while no point could be initialised.
+  BaselineFromMotion baseline_from_motion_;
+  std::unordered_map<PointId, Eigen::Vector4d> previous_candidates_;
+  std::vector<std::pair<StereoObservation, StereoObservation>> given_links_;
 };
 
 }  // namespace osc

@@ -5,6 +5,7 @@
 /// front end's predicted windows lose every track.
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -13,6 +14,12 @@
 #include "online_stereo_calibration/core/geometry/camera_model.h"
 
 namespace osc {
+
+/// Mutual best matches between descriptor rows (Hamming if @p binary, else L2), each better
+/// than @p ratio times the second best in both directions (Lowe's ratio test): pairs of
+/// (row of @p previous, row of @p current). Rows of different types or lengths give none.
+std::vector<std::pair<int, int>> matchDescriptors(const cv::Mat& previous, const cv::Mat& current,
+                                                  bool binary, double ratio);
 
 /// Matches the 500 strongest keypoints (detector response) of the previous left image to the
 /// current one's 500: mutual best

@@ -56,6 +56,8 @@ class StereoFrontEnd {
   /// distance to tracks and bucketing select among them (raw pixels, refined right pixel,
   /// id 0).
   const std::vector<StereoObservation>& lastStereoMatches() const { return last_matches_; }
+  /// The left keypoints' descriptors of lastStereoMatches(), one row each in the same order.
+  cv::Mat lastStereoMatchDescriptors() const;
   /// Search windows of the last pair.
   const std::vector<TrackWindow>& lastWindows() const { return last_windows_; }
   /// The last pair's common distance of refined pairs from their epipolar lines.
@@ -111,6 +113,7 @@ class StereoFrontEnd {
   /// tracked pairs to fit its own.
   EpipolarTrend epipolar_trend_;
   std::vector<StereoObservation> last_tracked_, last_new_, last_matches_;
+  std::vector<int> last_match_keypoints_;  ///< left keypoint of each of last_matches_
   std::vector<TrackWindow> last_windows_;
   std::vector<EpipolarBand> last_bands_;
 };

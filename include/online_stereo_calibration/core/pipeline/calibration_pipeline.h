@@ -147,6 +147,16 @@ class CalibrationPipeline {
   /// The hand-eye start at image level: the left images' own keypoint matches when the
   /// estimator's tracks gave it no pair (StereoCalibrationEstimator::wantsLeftCameraMatches).
   void feedHandEye(const MotionIncrement& motion);
+  /// The baseline's length from motion at image level: the front end keeps no track of pairs
+  /// the filter refused, so while the estimator wants them (wantsStereoLinks) this pair's stereo
+  /// matches are matched to the previous pair's by their left descriptors and handed over
+  /// (before processFrame).
+  void linkStereoMatchesToPreviousPair();
+  /// After a pair: its stereo matches kept while the estimator wants links, else forgotten.
+  void keepStereoMatchesForTheNextPair();
+  /// The previous pair's stereo matches (raw pixels) and their left descriptors (one row each).
+  std::vector<StereoObservation> previous_stereo_matches_;
+  cv::Mat previous_stereo_match_descriptors_;
 };
 
 }  // namespace osc

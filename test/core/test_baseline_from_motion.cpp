@@ -1,0 +1,159 @@
+/// @file test_baseline_from_motion.cpp
+/// @brief The baseline's length from the left camera's motion (baseline_from_motion.h):
+/// inverse depths from two views, and the line rho_b = L rho_m + c over synthetic scenes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "online_stereo_calibration/core/estimator/baseline_from_motion.h"
+#include "online_stereo_calibration/core/geometry/rotation.h"
+
+namespace osc {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kFocal = 600.0;
+
+Eigen::Vector2d project(const Eigen::Vector3d& X) { return X.head<2>() / X.z(); }
+
+// A point at depth 8 m seen from a second camera 0.4 m to the side and turned by 2 deg: its
+// inverse depth is 1/8 per metre, and 0.4/8 in units of the second camera's distance.
+TEST(InverseDepthFromTwoViews, IsTheInverseDepthInUnitsOfTheTranslation) {
+  const Eigen::Vector3d X(1.5, -0.7, 8.0);
+  const Eigen::Matrix3d R = expSO3(Eigen::Vector3d(0.01, 2.0 * kDeg, -0.02));
+  const Eigen::Vector3d t(-0.4, 0.02, 0.03);
+  const Eigen::Vector3d ray = X / X.z();
+  const Eigen::Vector2d other = project(R * X + t);
+  double sigma = 0.0;
+  EXPECT_NEAR(inverseDepthFromTwoViews(ray, other, R, t, 0.5 / kFocal, &sigma), 1.0 / 8.0, 1e-12);
+  EXPECT_NEAR(inverseDepthFromTwoViews(ray, other, R, t.normalized(), 0.0), t.norm() / 8.0, 1e-12);
+  // Half a pixel in each view over a 0.4 m baseline at 600 px: about 0.0029 / m.
+  EXPECT_NEAR(sigma, std::sqrt(2.0) * 0.5 / kFocal / 0.4, 0.0005);
+  // Without translation there is no parallax: NaN, not a number that looks like a depth.
+  EXPECT_TRUE(std::isnan(inverseDepthFromTwoViews(ray, other, R, Eigen::Vector3d::Zero(), 0.0)));
+}
+
+/// A 0.3 m rig (right camera at optical +x, turned by @p yaw_error about optical y against
+/// what the estimate says) driving forward 0.8 m per pair through points at 4-60 m; the
+/// estimate's baseline is @p guessed_length long.
+struct Drive {
+  double true_length = 0.3;
+  double yaw_error = 0.0;
+  double step = 0.8;         ///< m forward per pair
+  double pixel_noise = 0.3;  ///< px
+  int points = 60;
+
+  /// Links of one pair: previous and current normalised left/right coordinates.
+  std::vector<StereoLink> pair(std::mt19937* rng) const {
+    std::uniform_real_distribution<double> lateral(-12.0, 12.0), height(-2.0, 3.0);
+    std::uniform_real_distribution<double> inverse_depth(1.0 / 60.0, 1.0 / 4.0);
+    std::normal_distribution<double> noise(0.0, pixel_noise / kFocal);
+    const Eigen::Matrix3d R_turn = expSO3(Eigen::Vector3d(0.0, 0.3 * kDeg, 0.0));
+    // X_right = R_rl X_left + t_rl: the right camera at +x of the left one.
+    const Eigen::Matrix3d R_rl = expSO3(Eigen::Vector3d(0.0, yaw_error, 0.0));
+    const Eigen::Vector3d t_rl = -R_rl * Eigen::Vector3d(true_length, 0.0, 0.0);
+    std::vector<StereoLink> links;
+    while (static_cast<int>(links.size()) < points) {
+      const double z = 1.0 / inverse_depth(*rng);
+      const Eigen::Vector3d current(lateral(*rng) * z / 20.0, height(*rng), z);
+      // The camera moved forward by step and turned a little: X_prev = R X_curr + t.
+      const Eigen::Vector3d previous = R_turn * current + Eigen::Vector3d(0.0, 0.0, step);
+      if (std::abs(current.x() / current.z()) > 0.6 || std::abs(previous.x() / previous.z()) > 0.6)
+        continue;
+      auto view = [&](const Eigen::Vector3d& X) {
+        Eigen::Vector4d v;
+        v << project(X), project(R_rl * X + t_rl);
+        for (int k = 0; k < 4; ++k) v(k) += noise(*rng);
+        return v;
+      };
+      links.push_back({view(previous), view(current)});
+    }
+    return links;
+  }
+};
+
+Eigen::Isometry3d estimatedRig(double length) {
+  // T_lopt_ropt: the right camera at +x, not turned (what the estimate believes).
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(length, 0.0, 0.0);
+  return T;
+}
+
+BaselineFromMotionConfig config() {
+  BaselineFromMotionConfig c;
+  c.motion.focal = kFocal;
+  c.pixel_noise = 0.3;
+  return c;
+}
+
+// The baseline guessed half as long (0.15 m for 0.3): five pairs of motion give 0.3 m
+// within 3 of its sigmas, and that sigma is a few percent; the guess's length does not enter.
+TEST(BaselineFromMotion, MeasuresABaselineGuessedHalfShort) {
+  std::mt19937 rng(7);
+  const Drive drive;
+  BaselineFromMotion estimator(config());
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_FALSE(estimator.estimate().valid);
+    EXPECT_TRUE(estimator.addPair(drive.pair(&rng), estimatedRig(0.15), drive.step))
+        << estimator.lastWhy();
+  }
+  const BaselineLength length = estimator.estimate();
+  ASSERT_TRUE(length.valid) << length.why;
+  EXPECT_NEAR(length.length, 0.3, 3.0 * length.sigma);
+  EXPECT_LT(length.sigma, 0.03);
+  EXPECT_NEAR(length.offset, 0.0, 1e-3);
+  // The guess's length does not matter, only its direction.
+  BaselineFromMotion other(config());
+  std::mt19937 same(7);
+  for (int k = 0; k < 5; ++k) other.addPair(drive.pair(&same), estimatedRig(0.45), drive.step);
+  EXPECT_NEAR(other.estimate().length, length.length, 1e-9);
+}
+
+// A right camera turned 0.3 deg about optical y against the estimate offsets every disparity
+// by 0.3 deg: the line's offset takes it, the slope (the length) stays right. Without the
+// offset term a point at 60 m (0.3 m / 60 m = 0.29 deg of disparity) would read twice as near.
+TEST(BaselineFromMotion, ARightCameraTurnedAlongTheLinesGoesIntoTheOffset) {
+  std::mt19937 rng(11);
+  Drive drive;
+  drive.yaw_error = 0.3 * kDeg;
+  BaselineFromMotion estimator(config());
+  for (int k = 0; k < 5; ++k) estimator.addPair(drive.pair(&rng), estimatedRig(0.15), drive.step);
+  const BaselineLength length = estimator.estimate();
+  ASSERT_TRUE(length.valid) << length.why;
+  EXPECT_NEAR(length.length, 0.3, 3.0 * length.sigma);
+  EXPECT_NEAR(std::abs(length.offset), 0.3 * kDeg, 0.03 * kDeg);
+  EXPECT_GT(std::abs(length.offset), 3.0 * length.offset_sigma);
+  // Turned back by the offset, the estimate's right camera is the true one (optical y), and
+  // the same drive measured with it has no offset left.
+  const Eigen::Isometry3d aligned = withoutDisparityOffset(estimatedRig(0.15), length.offset);
+  const Eigen::Matrix3d R_true = expSO3(Eigen::Vector3d(0.0, drive.yaw_error, 0.0));
+  EXPECT_LT(logSO3(aligned.linear() * R_true).norm(), 0.05 * kDeg);
+  EXPECT_LT((aligned.translation() - Eigen::Vector3d(0.15, 0.0, 0.0)).norm(), 1e-12)
+      << "the right camera turns about its centre";
+  std::mt19937 again(11);
+  BaselineFromMotion refit(config());
+  for (int k = 0; k < 5; ++k) refit.addPair(drive.pair(&again), aligned, drive.step);
+  EXPECT_LT(std::abs(refit.estimate().offset), 0.03 * kDeg);
+}
+
+// A standing camera (or one that moved 2 cm) tells nothing about the length: no pair counts,
+// and the estimate says why.
+TEST(BaselineFromMotion, AStandingCameraTellsNothing) {
+  std::mt19937 rng(3);
+  Drive drive;
+  drive.step = 0.02;
+  BaselineFromMotion estimator(config());
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_FALSE(estimator.addPair(drive.pair(&rng), estimatedRig(0.15), drive.step));
+    EXPECT_NE(estimator.lastWhy().find("the left camera moved 0.02 m"), std::string::npos)
+        << estimator.lastWhy();
+  }
+  const BaselineLength length = estimator.estimate();
+  EXPECT_FALSE(length.valid);
+  EXPECT_NE(length.why.find("0 pairs"), std::string::npos) << length.why;
+}
+
+}  // namespace
+}  // namespace osc
