@@ -218,10 +218,13 @@ BaselineLength BaselineFromMotion::estimate() const {
   // Each pair's points share that pair's motion fit (its direction is a degree or so off over
   // a few dozen points), an error the per-point sigmas do not see: the pairs' own lengths
   // scatter by it, so the mean of K of them is known to their spread / sqrt(K) at best.
-  double mean = 0.0, spread = 0.0;
-  for (double l : pair_lengths_) mean += l / pair_lengths_.size();
-  for (double l : pair_lengths_) spread += (l - mean) * (l - mean) / (pair_lengths_.size() - 1);
-  result.sigma = std::max(result.sigma, std::sqrt(spread / pair_lengths_.size()));
+  if (pair_lengths_.size() >= 2) {
+    const double k = static_cast<double>(pair_lengths_.size());
+    double mean = 0.0, spread = 0.0;
+    for (double l : pair_lengths_) mean += l / k;
+    for (double l : pair_lengths_) spread += (l - mean) * (l - mean) / (k - 1.0);
+    result.sigma = std::max(result.sigma, std::sqrt(spread / k));
+  }
   result.offset_sigma = std::sqrt(std::max(0.0, covariance(1, 1)) * reduced);
   if (!(result.length > 0.0) || !(result.sigma <= config_.max_relative_sigma * result.length)) {
     why << "length " << result.length << " m with 1 sigma " << result.sigma << " m (at most "

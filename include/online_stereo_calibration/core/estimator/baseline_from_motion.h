@@ -41,7 +41,7 @@ struct BaselineFromMotionConfig {
   double pixel_noise = 0.5;         ///< px, of each normalised coordinate times the focal
   double min_translation = 0.05;    ///< m of left-camera motion per pair: below, no parallax
   int min_pair_inliers = 10;        ///< fewest points on the line in one pair to count it
-  int min_pairs = 5;                ///< fewest pairs before an estimate is given (>= 2)
+  int min_pairs = 5;                ///< fewest pairs before an estimate is given
   int min_inliers = 30;             ///< fewest points over all pairs
   double max_relative_sigma = 0.1;  ///< sigma_L / L at most for an estimate
 };
@@ -50,7 +50,9 @@ struct BaselineFromMotionConfig {
 struct BaselineLength {
   bool valid = false;
   double length = 0.0;  ///< m
-  double sigma = 0.0;   ///< m, 1 sigma of the fit (inflated by its reduced chi-square)
+  /// m, 1 sigma: the fit's (inflated by its reduced chi-square), at least the pairs' own
+  /// lengths' spread / sqrt(pairs).
+  double sigma = 0.0;
   /// c: the disparity offset of the stereo estimate (rad, withoutDisparityOffset) and its
   /// 1 sigma (inflated as sigma).
   double offset = 0.0, offset_sigma = 0.0;
