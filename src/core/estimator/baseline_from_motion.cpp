@@ -31,21 +31,27 @@ double residualVariance(const InverseDepths& d, double L) {
   return d.stereo_sigma * d.stereo_sigma + L * L * d.motion_sigma * d.motion_sigma;
 }
 
-/// Weighted least squares of the line over @p inliers at slope @p L (for the weights).
-bool fitLine(const std::vector<InverseDepths>& depths, const std::vector<int>& inliers, double L,
-             Eigen::Vector2d* line) {
-  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+/// Adds @p inliers to @p sums, weighted by their residual's variance at slope @p L.
+void addToSums(const std::vector<InverseDepths>& depths, const std::vector<int>& inliers, double L,
+               LineSums* sums) {
   for (int i : inliers) {
     const InverseDepths& d = depths[static_cast<size_t>(i)];
     const double w = 1.0 / residualVariance(d, L);
     const Eigen::Vector2d row(d.motion, d.offset_gain);
-    A += w * row * row.transpose();
-    b += w * row * d.stereo;
+    sums->normal += w * row * row.transpose();
+    sums->right_side += w * row * d.stereo;
+    sums->weighted_y2 += w * d.stereo * d.stereo;
   }
-  const Eigen::LDLT<Eigen::Matrix2d> ldlt(A);
-  if (ldlt.info() != Eigen::Success || !(std::abs(A.determinant()) > 0.0)) return false;
-  *line = ldlt.solve(b);
+}
+
+/// Weighted least squares of the line over @p inliers at slope @p L (for the weights).
+bool fitLine(const std::vector<InverseDepths>& depths, const std::vector<int>& inliers, double L,
+             Eigen::Vector2d* line) {
+  LineSums sums;
+  addToSums(depths, inliers, L, &sums);
+  const Eigen::LDLT<Eigen::Matrix2d> ldlt(sums.normal);
+  if (ldlt.info() != Eigen::Success || !(std::abs(sums.normal.determinant()) > 0.0)) return false;
+  *line = ldlt.solve(sums.right_side);
   return line->allFinite();
 }
 
@@ -175,16 +181,8 @@ bool BaselineFromMotion::addPair(const std::vector<StereoLink>& links,
     last_why_ = std::to_string(best.size()) + " of " + std::to_string(n) + " points on one line";
     return false;
   }
-  for (int i : best) {
-    const InverseDepths& d = depths[static_cast<size_t>(i)];
-    const double w = 1.0 / residualVariance(d, best_line(0));
-    const Eigen::Vector2d row(d.motion, d.offset_gain);
-    normal_ += w * row * row.transpose();
-    right_side_ += w * row * d.stereo;
-    weighted_y2_ += w * d.stereo * d.stereo;
-  }
+  addToSums(depths, best, best_line(0), &sums_);
   pair_lengths_.push_back(best_line(0));
-  ++pairs_;
   inliers_ += static_cast<int>(best.size());
   last_why_.clear();
   return true;
@@ -192,17 +190,18 @@ bool BaselineFromMotion::addPair(const std::vector<StereoLink>& links,
 
 BaselineLength BaselineFromMotion::estimate() const {
   BaselineLength result;
-  result.pairs = pairs_;
+  const int pairs = static_cast<int>(pair_lengths_.size());
+  result.pairs = pairs;
   result.inliers = inliers_;
   std::ostringstream why;
-  if (pairs_ < config_.min_pairs || inliers_ < config_.min_inliers) {
-    why << pairs_ << " pairs and " << inliers_ << " points so far (least " << config_.min_pairs
+  if (pairs < config_.min_pairs || inliers_ < config_.min_inliers) {
+    why << pairs << " pairs and " << inliers_ << " points so far (least " << config_.min_pairs
         << " and " << config_.min_inliers << ")";
     result.why = why.str();
     return result;
   }
-  const Eigen::LDLT<Eigen::Matrix2d> ldlt(normal_);
-  const Eigen::Vector2d line = ldlt.solve(right_side_);
+  const Eigen::LDLT<Eigen::Matrix2d> ldlt(sums_.normal);
+  const Eigen::Vector2d line = ldlt.solve(sums_.right_side);
   const Eigen::Matrix2d covariance = ldlt.solve(Eigen::Matrix2d::Identity());
   if (ldlt.info() != Eigen::Success || !line.allFinite() || !covariance.allFinite()) {
     result.why = "the line fit is singular";
@@ -210,7 +209,8 @@ BaselineLength BaselineFromMotion::estimate() const {
   }
   // Reduced chi-square: the per-point sigmas are first-order and ignore the motion fit's own
   // error (common to a pair's points), so the scatter decides when it is larger.
-  const double chi2 = weighted_y2_ - 2.0 * line.dot(right_side_) + line.dot(normal_ * line);
+  const double chi2 =
+      sums_.weighted_y2 - 2.0 * line.dot(sums_.right_side) + line.dot(sums_.normal * line);
   const double reduced = std::max(1.0, chi2 / std::max(1, inliers_ - 2));
   result.length = line(0);
   result.offset = line(1);
@@ -237,10 +237,7 @@ BaselineLength BaselineFromMotion::estimate() const {
 }
 
 void BaselineFromMotion::clear() {
-  normal_.setZero();
-  right_side_.setZero();
-  weighted_y2_ = 0.0;
-  pairs_ = 0;
+  sums_ = LineSums();
   inliers_ = 0;
   pair_lengths_.clear();
   last_why_.clear();

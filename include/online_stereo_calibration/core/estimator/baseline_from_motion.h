@@ -76,6 +76,15 @@ double inverseDepthFromTwoViews(const Eigen::Vector3d& ray, const Eigen::Vector2
 /// along their epipolar lines) and motion does.
 Eigen::Isometry3d withoutDisparityOffset(const Eigen::Isometry3d& T_lopt_ropt, double offset);
 
+/// Sums of the weighted least squares of rho_b = L rho_m + c k (k = 1 + s^2) over points
+/// with weights w: normal = sum w [rho_m k]^T [rho_m k], right_side = sum w [rho_m k]^T rho_b,
+/// weighted_y2 = sum w rho_b^2 (for the chi-square).
+struct LineSums {
+  Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d right_side = Eigen::Vector2d::Zero();
+  double weighted_y2 = 0.0;
+};
+
 /// Accumulates pairs of consecutive stereo pairs until the length is known.
 class BaselineFromMotion {
  public:
@@ -95,11 +104,9 @@ class BaselineFromMotion {
 
  private:
   BaselineFromMotionConfig config_;
-  /// Sums over the inliers of w [rho_m k]^T [rho_m k] and w [rho_m k]^T rho_b (k: 1 + s^2).
-  Eigen::Matrix2d normal_ = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d right_side_ = Eigen::Vector2d::Zero();
-  double weighted_y2_ = 0.0;  ///< sum w rho_b^2 (for the chi-square)
-  int pairs_ = 0, inliers_ = 0;
+  /// The weighted least-squares sums of the line over the inliers of every pair so far.
+  LineSums sums_;
+  int inliers_ = 0;
   std::vector<double> pair_lengths_;  ///< each pair's own length
   std::string last_why_;
 };
