@@ -458,6 +458,10 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
         warning.rfind("x_camr's rotation", 0) == 0) {
       diagnostics_->recordProblem("right camera rotation contradicted", warning);
     }
+    if (result.estimator.right_camera_off_epipolar_lines &&
+        warning.rfind("the stereo pairs left x_camr's epipolar lines", 0) == 0) {
+      diagnostics_->recordProblem("right camera off its epipolar lines", warning);
+    }
     if (result.estimator.too_few_points && warning.rfind("too few points", 0) == 0) {
       diagnostics_->recordProblem("too few points to update", warning);
     }

@@ -846,6 +846,25 @@ TEST(CameraModel, UndistortStaysOnTheUnfoldedBranchAndRejectsUnreachablePixels) 
   EXPECT_FALSE(equidistant.undistort(Eigen::Vector2d(1.7, 0.0), &untouched));
 }
 
+TEST(CameraModel, UndistortedPixelNoiseIsTheRawNoiseStretchedByTheLens) {
+  // Without distortion an undistorted pixel is the raw one: the same variance, exactly.
+  CameraIntrinsics pinhole = fisheyeCamera();
+  pinhole.model = DistortionModel::kNone;
+  pinhole.distortion.clear();
+  EXPECT_EQ(CameraModel(pinhole).undistortedPixelVariance(Eigen::Vector2d(700.0, 20.0), 0.5), 0.25);
+  // A fisheye 50 deg off its axis: r_u = f tan(theta) against r_d ~ f theta, so a raw pixel's
+  // noise is stretched by 1 / cos^2(theta) = 2.4 radially (tan(theta) / theta = 1.4
+  // tangentially); the variance takes the larger stretch.
+  const CameraModel fisheye(fisheyeCamera());
+  const double theta = 50.0 * M_PI / 180.0;
+  const Eigen::Vector2d undistorted(376.5 + 380.0 * std::tan(theta), 239.5);
+  const double radial = (1.0 / std::pow(std::cos(theta), 2)) * 0.5;
+  EXPECT_NEAR(fisheye.undistortedPixelVariance(undistorted, 0.5), radial * radial,
+              0.1 * radial * radial);  // the lens's small k1..k4 change it by a few percent
+  // At the centre the lens barely stretches.
+  EXPECT_NEAR(fisheye.undistortedPixelVariance(Eigen::Vector2d(376.5, 239.5), 0.5), 0.25, 0.01);
+}
+
 TEST(CameraModel, EquidistantDistortionIsTheKannalaBrandtPolynomial) {
   // theta = atan(r), theta_d = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8),
   // distorted = normalized * theta_d / r.

@@ -78,7 +78,8 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "window of the measured rotation's mean square; rotation within the motion noise is "
            "not excitation of the camera position (0 = off, as the paper)"),
       real("pixel_noise_px", &C::pixel_noise, 1.0, 1e-3, 100.0,
-           "default standard deviation of a feature position"),
+           "default standard deviation of a feature position in the raw image (stretched "
+           "through the lens for the undistorted pixels the filter measures)"),
       real("outlier_gate", &C::outlier_gate, 1.0, 1.0, 1e6,
            "chi-square(4) bound on a point's stereo innovation; beyond it the point is an outlier"),
       real("initial_caml_translation_sigma_m", &C::initial_caml_translation_sigma, 1.0, 1e-6, 100.0,
@@ -127,6 +128,11 @@ const std::vector<ParameterSpec>& filterParameterTable() {
               "updates in a row beyond that bound before x_camr's rotation is widened"),
       real("jump_score_widening", &C::jump_score_widening, 1.0, 0.1, 100.0,
            "x_camr's rotation variance grows by (this x the indicated rotation shift)^2 per axis"),
+      real("epipolar_knock_false_alarm", &C::epipolar_knock_false_alarm, 1.0, 0.0, 0.5,
+           "false-alarm probability per image pair of the test that the stereo pairs left "
+           "x_camr's epipolar lines (a knocked right camera; epipolar_consistency.h); 0 = off"),
+      integer("epipolar_knock_pairs", &C::epipolar_knock_pairs, 1, 1000,
+              "image pairs in a row beyond that bound before x_camr's rotation is re-opened"),
       integer("relinearization_frames", &C::relinearization_frames, 0, 100000,
               "frames between checks whether the estimate left its start (linearisation) "
               "point; 0 = never restart"),
@@ -296,6 +302,7 @@ FilterConfig paperFilterConfig() {
   config.motion_excitation_window = 0.0;      // the paper linearises at the measured motion
   config.consistency_window = 0.0;            // the paper's random walk is fixed
   config.jump_score_false_alarm = 0.0;        // ... and its knocks found by gated points
+  config.epipolar_knock_false_alarm = 0.0;    // ... only
   config.relinearization_frames = 0;          // the paper's filter runs on from its start
   config.max_sigma_shrink_per_update = 0.0;   // ... and updates as the UKF does
   config.thin_evidence_points = 0;            // ... on any evidence

@@ -6,6 +6,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "online_stereo_calibration/core/estimator/epipolar_consistency.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
@@ -236,8 +237,13 @@ bool StereoCalibrationEstimator::toMeasurement(const StereoObservation& o,
   m->z << left_undistorted, right_undistorted;
   const double sl = o.sigma_left > 0.0 ? o.sigma_left : config_.pixel_noise;
   const double sr = o.sigma_right > 0.0 ? o.sigma_right : config_.pixel_noise;
-  m->variance << sl * sl, sl * sl, sr * sr, sr * sr;
-  return m->z.allFinite();
+  // The sigmas are the raw images'; the filter measures undistorted pixels. Without the
+  // lens's stretch, wide-angle runs' stereo pairs lay off x_camr's epipolar lines by up to 40
+  // times what their stated noise allows (default campaign runs 123, 180; RESULTS Session 21).
+  const double vl = left_.undistortedPixelVariance(left_undistorted, sl);
+  const double vr = right_.undistortedPixelVariance(right_undistorted, sr);
+  m->variance << vl, vl, vr, vr;
+  return m->z.allFinite() && m->variance.allFinite();
 }
 
 FrameReport StereoCalibrationEstimator::processFrame(
@@ -262,6 +268,10 @@ FrameReport StereoCalibrationEstimator::processFrame(
         " observation(s) ignored: NaN/Inf pixel or sigma, or a pixel no ray of the lens "
         "model reaches");
   }
+
+  // Before the update: after a knock the tracked points would pull x_camr with its old
+  // sigma, or gate out and be blamed on x_caml.
+  reopenIfOffEpipolarLines(&tracked, &candidates, &report);
 
   if (has_previous_frame_) {
     // A handful of points moved the calibration by more than they told it (a dim stretch of
@@ -360,6 +370,34 @@ FrameReport StereoCalibrationEstimator::processFrame(
   }
   report.dropped.swap(still_dropped);
   return report;
+}
+
+bool StereoCalibrationEstimator::reopenIfOffEpipolarLines(std::vector<PointMeasurement>* tracked,
+                                                          std::vector<PointMeasurement>* candidates,
+                                                          FrameReport* report) {
+  if (!(config_.epipolar_knock_false_alarm > 0.0)) return false;
+  std::vector<PointMeasurement> pairs = *tracked;
+  pairs.insert(pairs.end(), candidates->begin(), candidates->end());
+  using namespace layout;
+  const Eigen::Matrix3d rotation_covariance =
+      filter_.covariance().block<3, 3>(kCamr + kRotation, kCamr + kRotation);
+  const EpipolarEvidence evidence =
+      testEpipolarLines(pairs, left_.K(), right_.K(), filter_.extrinsics(), rotation_covariance,
+                        config_.epipolar_knock_false_alarm, config_.jump_min_points);
+  pairs_off_epipolar_lines_ = evidence.contradicts ? pairs_off_epipolar_lines_ + 1 : 0;
+  if (pairs_off_epipolar_lines_ < config_.epipolar_knock_pairs) return false;
+  pairs_off_epipolar_lines_ = 0;
+  const std::vector<PointId> forgotten = reopenRightCameraRotation(3.0 * evidence.angle);
+  report->dropped.insert(report->dropped.end(), forgotten.begin(), forgotten.end());
+  candidates->insert(candidates->end(), tracked->begin(), tracked->end());
+  tracked->clear();
+  report->right_camera_off_epipolar_lines = true;
+  report->warnings.push_back("the stereo pairs left x_camr's epipolar lines in " +
+                             std::to_string(config_.epipolar_knock_pairs) +
+                             " image pairs in a row (" + evidence.summary() +
+                             "): x_camr's rotation re-opened (a knocked right camera?), "
+                             "points re-initialised");
+  return true;
 }
 
 void StereoCalibrationEstimator::forgetBaselineEvidence() {
@@ -513,6 +551,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
   guess_ = guess;
   forgetBaselineEvidence();
   held_for_few_points_ = false;
+  pairs_off_epipolar_lines_ = 0;
   mounting_.clear();
   filter_.reset(guess);
   guess_covariance_ = filter_.covariance();
@@ -525,6 +564,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
   guess_ = guess;
   forgetBaselineEvidence();
   held_for_few_points_ = false;
+  pairs_off_epipolar_lines_ = 0;
   mounting_.clear();
   // The given covariance is one as estimate() reports it (a saved calibration): take out what
   // the odometry's scale adds there, so that save -> restore -> estimate() gives it back. If

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include <Eigen/LU>
+#include <Eigen/SVD>
 
 namespace osc {
 
@@ -228,6 +229,15 @@ Eigen::Matrix2d CameraModel::lensJacobian(const Eigen::Vector2d& undistorted_pix
     jacobian.col(k) = (toRaw(undistorted_pixel + du) - toRaw(undistorted_pixel - du)) / (2.0 * h);
   }
   return jacobian;
+}
+
+double CameraModel::undistortedPixelVariance(const Eigen::Vector2d& undistorted_pixel,
+                                             double raw_sigma) const {
+  const double raw_variance = raw_sigma * raw_sigma;
+  if (intrinsics_.model == DistortionModel::kNone) return raw_variance;
+  const double least_stretch =
+      Eigen::JacobiSVD<Eigen::Matrix2d>(lensJacobian(undistorted_pixel)).singularValues()(1);
+  return raw_variance / (least_stretch * least_stretch);
 }
 
 Eigen::Vector2d CameraModel::pixelToNormalized(const Eigen::Vector2d& pixel) const {

@@ -59,7 +59,9 @@ struct FilterConfig {
   double motion_excitation_window = 5.0;
 
   // --- measurements, seed eq. 29-30 ---
-  double pixel_noise = 0.5;     ///< px, default sigma of a feature position
+  /// px, default sigma of a feature position in the raw image (CameraModel::
+  /// undistortedPixelVariance stretches it for the undistorted pixels the filter measures)
+  double pixel_noise = 0.5;
   double outlier_gate = 18.47;  ///< chi-square(4) of a stereo innovation; 18.47 = 99.9 %
 
   // --- initial uncertainty of the guess (1 sigma) ---
@@ -125,6 +127,15 @@ struct FilterConfig {
   double jump_score_false_alarm = 1e-6;
   int jump_score_updates = 2;
   double jump_score_widening = 3.0;
+  /// x_camr re-opened when the stereo pairs leave its epipolar lines (epipolar_consistency.h):
+  /// their statistic beyond the chi-square bound of this false-alarm probability in
+  /// epipolar_knock_pairs image pairs in a row (at least jump_min_points stereo pairs each)
+  /// re-opens x_camr's rotation to 3 times the indicated rotation and forgets the points.
+  /// The epipolar lines depend on x_camr alone: a knock inside a stretch without points,
+  /// which the new points' gating blamed on x_caml (default campaign run 102: yaw_r 193
+  /// sigma off), is found in the first two pairs after it. 0 = off.
+  double epipolar_knock_false_alarm = 1e-6;
+  int epipolar_knock_pairs = 2;
 
   // --- re-linearisation after a start or a re-opening (issue 14) ---
   /// Every this many frames after a start (or a re-opened block), the estimator compares the

@@ -84,6 +84,11 @@ struct FrameReport {
   /// camera's motion (FilterConfig::baseline_from_motion; no point could be initialised with
   /// the guess's; the warning names the old and new length); tracks reset.
   bool baseline_from_motion = false;
+  /// x_camr's rotation was re-opened before this pair's update: the stereo pairs had left its
+  /// epipolar lines for FilterConfig::epipolar_knock_pairs pairs in a row (a knocked right
+  /// camera; the warning names the statistic and the indicated rotation); every point
+  /// forgotten, this pair's initialised afresh.
+  bool right_camera_off_epipolar_lines = false;
   std::vector<std::string> warnings;  ///< human-readable, one per problem
 };
 
@@ -216,6 +221,12 @@ class StereoCalibrationEstimator {
   bool learnBaselineLength(const MotionIncrement& motion, bool motion_links_pairs,
                            const std::vector<PointMeasurement>& candidates, FrameReport* report);
   void forgetBaselineEvidence();
+  /// Tests this pair's stereo pairs (tracked and new) against x_camr's epipolar lines
+  /// (epipolar_consistency.h) and, after FilterConfig::epipolar_knock_pairs contradicting
+  /// pairs in a row, re-opens x_camr's rotation (reopenRightCameraRotation): the tracked
+  /// points then join the candidates. True if it did.
+  bool reopenIfOffEpipolarLines(std::vector<PointMeasurement>* tracked,
+                                std::vector<PointMeasurement>* candidates, FrameReport* report);
 
   FilterConfig config_;
   CameraModel left_;
@@ -224,6 +235,8 @@ class StereoCalibrationEstimator {
   bool has_previous_frame_ = false;
   /// The last pair had too few stereo pairs to update (FrameReport::too_few_points).
   bool held_for_few_points_ = false;
+  /// Pairs in a row whose stereo pairs contradicted x_camr's epipolar lines.
+  int pairs_off_epipolar_lines_ = 0;
   LinearizationAnchor anchor_;
   /// The last start's guess and its tangent covariance (restartFromMotion starts from them).
   StereoExtrinsics guess_;

@@ -74,6 +74,12 @@ class CameraModel {
   /// d undistorted pixel there (central differences over +-0.5 px; exactly the identity
   /// without distortion).
   Eigen::Matrix2d lensJacobian(const Eigen::Vector2d& undistorted_pixel) const;
+  /// Variance (undistorted px^2) of each coordinate of an undistorted pixel whose raw pixel
+  /// has @p raw_sigma (px) per coordinate. Undistorting stretches the raw noise by the inverse
+  /// of lensJacobian (a fisheye's edge: 2.4 times radially at 50 deg off its axis); one
+  /// variance for both coordinates, so the largest stretch (exactly raw_sigma^2 without
+  /// distortion).
+  double undistortedPixelVariance(const Eigen::Vector2d& undistorted_pixel, double raw_sigma) const;
 
   /// True if the pixel lies inside the image with the given margin (pixels).
   bool isInImage(const Eigen::Vector2d& pixel, double margin = 0.0) const;

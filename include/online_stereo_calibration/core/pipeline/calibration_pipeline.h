@@ -47,7 +47,8 @@ struct PipelineResult {
   /// images had features and the pair's whole-image fit contradicts x_camr, or the
   /// refined pairs of this and the previous pair off their epipolar lines by far more than
   /// x_camr's sigma allows.
-  /// x_camr's rotation was re-opened and tracking restarted.
+  /// x_camr's rotation was re-opened and tracking restarted (also when the estimator found
+  /// the pairs off x_camr's epipolar lines: estimator.right_camera_off_epipolar_lines).
   bool right_camera_reopened = false;
   /// The whole-image stereo fit at a start was tried in this pair
   /// (FilterConfig::stereo_fit_start); stereo_fit is its seed (valid if the fit was), and

@@ -1,0 +1,53 @@
+/// @file epipolar_consistency.h
+/// @brief Do a pair's stereo matches lie on the epipolar lines of the current x_camr?
+///
+/// A stereo pair's epipolar constraint (seed eq. 5) depends on x_camr alone: not on x_caml,
+/// the vehicle's motion, the odometry's errors or the points' depths. So it tells a knocked
+/// right camera from everything else, even when no tracked point could contradict the knock
+/// (a knock inside a stretch without points: the points after it are new, triangulated with
+/// the old x_camr; default campaign run 102 then blamed x_caml and kept yaw_r 193 sigma off).
+///
+/// The test: each pair's algebraic epipolar residual r_i = x_r^T F x_l, normalised by its
+/// pixel noise, is linear in x_camr's rotation error d (r_i = a_i^T d + n_i). With
+/// H = sum a a^T / s^2 and b = sum a r / s^2, b has covariance H + H P H if x_camr is within
+/// its covariance P, so T = b^T (H + H P H)^+ b is chi-square with rank(H) degrees of freedom
+/// (2: the rotation that slides pixels along the lines, yaw_r of a horizontal rig, does not
+/// enter). Pairs far off (mismatches) are down-weighted (Huber) so that one does not decide.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "online_stereo_calibration/core/filter/calibration_filter.h"
+#include "online_stereo_calibration/core/geometry/pose.h"
+
+namespace osc {
+
+/// What a pair's stereo matches say about x_camr's rotation.
+struct EpipolarEvidence {
+  int pairs = 0;           ///< stereo matches used
+  int dof = 0;             ///< rank of their information about x_camr's rotation
+  double statistic = 0.0;  ///< T above; chi-square with dof degrees of freedom if x_camr holds
+  double bound = 0.0;      ///< T's upper quantile at the false-alarm probability asked for
+  /// x_camr's rotation error the matches alone indicate (rad, boxPlus tangent of
+  /// T_caml_camr; their least-squares fit), and its angle.
+  Eigen::Vector3d rotation_shift = Eigen::Vector3d::Zero();
+  double angle = 0.0;
+  /// statistic > bound, from at least the pairs asked for.
+  bool contradicts = false;
+  /// "12 of 40 pairs off x_camr's epipolar lines: T 310 > 27.6, 0.52 deg" (for warnings).
+  std::string summary() const;
+};
+
+/// Tests @p pairs (undistorted pixels [u_l, v_l, u_r, v_r] and their variances) against the
+/// epipolar geometry of @p extrinsics' x_camr, whose rotation has the tangent covariance
+/// @p rotation_covariance (rad^2). Fewer than @p min_pairs usable pairs never contradict.
+EpipolarEvidence testEpipolarLines(const std::vector<PointMeasurement>& pairs,
+                                   const Eigen::Matrix3d& K_left, const Eigen::Matrix3d& K_right,
+                                   const StereoExtrinsics& extrinsics,
+                                   const Eigen::Matrix3d& rotation_covariance, double false_alarm,
+                                   int min_pairs);
+
+}  // namespace osc
