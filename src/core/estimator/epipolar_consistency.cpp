@@ -19,22 +19,6 @@ constexpr double kHuber = 3.0;          // normalised residuals beyond this are 
 constexpr int kReweightings = 3;        // Huber iterations
 constexpr double kRelativeRank = 1e-6;  // eigenvalues below this share of the largest: no info
 
-/// Upper chi-square quantile, exact for 1 and 2 degrees of freedom (the usual ranks here),
-/// where Wilson-Hilferty is poor.
-double chiSquareBound(int dof, double probability) {
-  if (dof == 2) return -2.0 * std::log(probability);
-  if (dof == 1) {
-    // P(X > q) = erfc(sqrt(q / 2)): bisection on q.
-    double low = 0.0, high = 200.0;
-    for (int i = 0; i < 100; ++i) {
-      const double q = 0.5 * (low + high);
-      (std::erfc(std::sqrt(0.5 * q)) > probability ? low : high) = q;
-    }
-    return 0.5 * (low + high);
-  }
-  return chiSquareUpperQuantile(dof, probability);
-}
-
 /// One pair's residual normalised by its noise, and its derivative in x_camr's rotation.
 struct NormalisedResidual {
   double r = 0.0;
@@ -122,7 +106,7 @@ EpipolarEvidence testEpipolarLines(const std::vector<PointMeasurement>& pairs,
     const double projection = eigen.eigenvectors().col(k).dot(b);
     evidence.statistic += projection * projection / lambda;
   }
-  evidence.bound = chiSquareBound(evidence.dof, false_alarm);
+  evidence.bound = chiSquareUpperQuantile(evidence.dof, false_alarm);
   evidence.contradicts = evidence.dof > 0 && evidence.statistic > evidence.bound;
   return evidence;
 }
