@@ -161,8 +161,10 @@ MeasurementScenario hoveringSmallRigScenario() {
 // sigma of 1.3-1.5 mm (rotation priors 0.2 / 2 deg); (a) and (b) remain. Points in units of
 // the baseline (FilterConfig::baseline_scaled_points, the default since) remove (a); (b) remains
 // and is then the only channel of the baseline: yr ends 230 / 172 mm off with a sigma of
-// 12 / 10 mm (the prediction linearised at the noisy measured translation; not tried with
-// motion_relinearizations 1).
+// 12 / 10 mm (the prediction linearised at the noisy measured translation). Repeating the step
+// at the corrected motion (motion_relinearizations, 1 by default since session 22) leaves yr
+// 4.1-4.8 sigma off with 1 pass, 2.4-3.0 sigma with 2, its sigma 13-15 mm either way (the test
+// below holds the first).
 TEST(Observability, DISABLED_HoveringSmallRigDoesNotLearnItsBaseline) {
   for (const double rotation_sigma_deg : {0.2, 2.0}) {
     FilterConfig config;
@@ -174,6 +176,27 @@ TEST(Observability, DISABLED_HoveringSmallRigDoesNotLearnItsBaseline) {
         << "rotation prior " << rotation_sigma_deg << " deg";
     EXPECT_LT(std::abs(error), 3.0 * r.sigmas(7))
         << "rotation prior " << rotation_sigma_deg << " deg";
+  }
+}
+
+// What the test above asks is not met yet; what the step repeated at the corrected motion
+// (FilterConfig::motion_relinearizations) does there is: the odometry's noise no longer pulls
+// the hovering rig's baseline 18 sigma off (measured with the shipped one pass: 4.1 and 4.8
+// sigma for rotation priors 0.2 and 2 deg; without: 18.4 and 18.6 sigma).
+TEST(Observability, AHoveringRigsBaselineIsNotPulledFarByTheOdometrysNoise) {
+  ASSERT_GT(FilterConfig().motion_relinearizations, 0);
+  for (const double rotation_sigma_deg : {0.2, 2.0}) {
+    FilterConfig config;
+    config.initial_camr_translation_sigma = 0.03;
+    config.initial_camr_rotation_sigma = rotation_sigma_deg * kDeg;
+    FilterConfig linearised_once = config;
+    linearised_once.motion_relinearizations = 0;
+    const ScenarioFrameResult shipped = lastFrame(hoveringSmallRigScenario(), 100, config);
+    const ScenarioFrameResult once = lastFrame(hoveringSmallRigScenario(), 100, linearised_once);
+    const double z_shipped = (shipped.parameters(7) - shipped.truth(7)) / shipped.sigmas(7);
+    const double z_once = (once.parameters(7) - once.truth(7)) / once.sigmas(7);
+    EXPECT_LT(std::abs(z_shipped), 6.0) << "rotation prior " << rotation_sigma_deg << " deg";
+    EXPECT_GT(std::abs(z_once), 12.0) << "rotation prior " << rotation_sigma_deg << " deg";
   }
 }
 

@@ -73,7 +73,8 @@ const std::vector<ParameterSpec>& filterParameterTable() {
       real("motion_translation_noise_m", &C::motion_translation_noise, 1.0, 0.0, 10.0,
            "error of the measured vehicle translation per axis per step (shared model)"),
       integer("motion_relinearizations", &C::motion_relinearizations, 0, 5,
-              "shared model: repeat the step linearised at the corrected motion (0 = off)"),
+              "shared model: repeat the step linearised at the corrected motion while the "
+              "vehicle is slower than 2 m/s (0 = off)"),
       real("motion_excitation_window_s", &C::motion_excitation_window, 1.0, 0.0, 1e4,
            "window of the measured rotation's mean square; rotation within the motion noise is "
            "not excitation of the camera position (0 = off, as the paper)"),
@@ -300,6 +301,7 @@ FilterConfig paperFilterConfig() {
   config.motion_noise_model = MotionNoiseModel::kPerPoint;
   config.motion_translation_noise = 0.0;      // "not considered in this paper"
   config.motion_excitation_window = 0.0;      // the paper linearises at the measured motion
+  config.motion_relinearizations = 0;         // ... once
   config.consistency_window = 0.0;            // the paper's random walk is fixed
   config.jump_score_false_alarm = 0.0;        // ... and its knocks found by gated points
   config.epipolar_knock_false_alarm = 0.0;    // ... only

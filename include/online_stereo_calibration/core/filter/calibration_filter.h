@@ -191,6 +191,9 @@ class CalibrationFilter {
   /// tangent) with respect to them (6 x odometry_dim_).
   void motionModel(const MotionIncrement& motion, Eigen::Isometry3d* corrected,
                    Eigen::MatrixXd* jacobian) const;
+  /// The step is worth repeating linearised at the corrected motion
+  /// (FilterConfig::motion_relinearizations): the vehicle is slower than 2 m/s.
+  bool wantsMotionRelinearized(const MotionIncrement& motion) const;
   /// One predict + update linearised at `motion` with the given prior mean of the motion
   /// error; a non-final pass only estimates the motion error. False: a jump was detected
   /// (the step is complete then).
