@@ -19,14 +19,15 @@ struct BenchmarkProblem {
   MotionIncrement motion;
   std::vector<PointMeasurement> first, second;
 
-  explicit BenchmarkProblem(int n) {
+  /// @p forward_step: metres driven between the two image pairs, 0.1 s apart.
+  explicit BenchmarkProblem(int n, double forward_step = 0.35) {
     K.K_left << 600, 0, 320, 0, 600, 240, 0, 0, 1;
     K.K_right = K.K_left;
     Vector12d p;
     p << 1.5, 0.15, 1.3, 0.0, 0.05, 0.0, 0.0, -0.3, 0.0, 0.0, 0.0, 0.0;
     truth = StereoExtrinsics::fromParameters(p);
     Vector6d m;
-    m << 0.35, 0.0, 0.01, 0.005, -0.004, 0.01;
+    m << forward_step, 0.0, 0.01, 0.005, -0.004, 0.01;
     motion.T_prev_curr = poseFromParameters(m);
     std::mt19937_64 rng(1);
     std::uniform_real_distribution<double> u(-1, 1);
@@ -59,9 +60,11 @@ Matrix12d convergedCovariance() {
   return sigma.array().square().matrix().asDiagonal();
 }
 
-/// One structured step with @p config (the shipped defaults, or the consistency monitor off).
-void structuredFilterStep(benchmark::State& state, const FilterConfig& config) {
-  const BenchmarkProblem problem(static_cast<int>(state.range(0)));
+/// One structured step with @p config (the shipped defaults, or the consistency monitor off),
+/// @p forward_step metres in 0.1 s.
+void structuredFilterStep(benchmark::State& state, const FilterConfig& config,
+                          double forward_step = 0.35) {
+  const BenchmarkProblem problem(static_cast<int>(state.range(0)), forward_step);
   CalibrationFilter prepared(config, problem.K);
   prepared.reset(problem.truth, convergedCovariance());
   for (const auto& m : problem.first) prepared.addPoint(m);
@@ -102,6 +105,19 @@ void BM_StructuredFilterStepUntempered(benchmark::State& state) {
   structuredFilterStep(state, config);
 }
 
+/// The same at 1 m/s: slower than 2 m/s the step is repeated at the corrected motion
+/// (motion_relinearizations 1, CalibrationFilter::wantsMotionRelinearized); what that costs.
+void BM_StructuredFilterStepSlow(benchmark::State& state) {
+  structuredFilterStep(state, FilterConfig(), 0.1);
+}
+
+/// The same slow step linearised once (motion_relinearizations 0): the baseline of the above.
+void BM_StructuredFilterStepSlowOnce(benchmark::State& state) {
+  FilterConfig config;
+  config.motion_relinearizations = 0;
+  structuredFilterStep(state, config, 0.1);
+}
+
 void BM_DenseUkfStep(benchmark::State& state) {
   const BenchmarkProblem problem(static_cast<int>(state.range(0)));
   DenseCalibrationUkf prepared(FilterConfig(), problem.K);
@@ -137,6 +153,12 @@ BENCHMARK(BM_StructuredFilterStepUntempered)
     ->Arg(400)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StructuredFilterStepWithPositions)
+    ->Arg(25)
+    ->Arg(100)
+    ->Arg(400)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StructuredFilterStepSlow)->Arg(25)->Arg(100)->Arg(400)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StructuredFilterStepSlowOnce)
     ->Arg(25)
     ->Arg(100)
     ->Arg(400)
