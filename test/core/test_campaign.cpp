@@ -287,6 +287,42 @@ TEST(CampaignScore, CountsFramesAgainstTheSigmasFromFrame30) {
   EXPECT_NEAR(s.rmse[5], std::sqrt((99 * 1e-4 + 16e-4) / 100), 1e-9);
 }
 
+// A knock at frame 50 inside a blind stretch 45-60: frames 50-60 are beyond 5 sigma because
+// nothing could be seen yet (unseen), frames 61-62 because the filter had not followed yet
+// (its own). Both count as beyond 5 sigma; only the first as unseen.
+TEST(CampaignScore, FramesBeyondInAnUnseenChangeAreToldApart) {
+  MeasurementScenario scenario;
+  scenario.frames = 100;
+  scenario.step.setZero();
+  scenario.step(9) = 0.01;
+  scenario.step_frame = 50;
+  scenario.blind_frames = {FrameSpan{10, 20}, FrameSpan{45, 60}};
+  const std::vector<FrameSpan> unseen = unseenChangeSpans(scenario);
+  ASSERT_EQ(unseen.size(), 1u);
+  EXPECT_EQ(unseen[0].first, 50);
+  EXPECT_EQ(unseen[0].last, 60);
+
+  std::vector<ScenarioFrameResult> frames;
+  for (int k = 0; k < 100; ++k) {
+    Vector12d z = Vector12d::Constant(1.0);
+    if (k >= 50 && k <= 62) z(9) = 40.0;
+    frames.push_back(frameWithErrors(k, z));
+  }
+  const CampaignScore s = scoreCampaignRun(frames, unseen);
+  EXPECT_EQ(s.frames_beyond_5sigma, 13);
+  EXPECT_EQ(s.frames_beyond_5sigma_unseen, 11);
+  EXPECT_EQ(scoreCampaignRun(frames).frames_beyond_5sigma_unseen, 0);
+
+  // A step where frames are tracked, none, or one before its blind stretch: nothing unseen.
+  scenario.step_frame = 30;
+  EXPECT_TRUE(unseenChangeSpans(scenario).empty());
+  scenario.step_frame = 44;
+  EXPECT_TRUE(unseenChangeSpans(scenario).empty());
+  scenario.step_frame = 50;
+  scenario.step.setZero();
+  EXPECT_TRUE(unseenChangeSpans(scenario).empty());
+}
+
 TEST(CampaignScore, NanEstimateIsBeyondEveryBound) {
   std::vector<ScenarioFrameResult> frames;
   for (int k = 0; k < 40; ++k) frames.push_back(frameWithErrors(k, Vector12d::Zero()));
@@ -310,6 +346,7 @@ TEST(CampaignCsv, RowsRoundTripAndFailedRowsKeepTheirColumns) {
   row.frames = 100;
   row.score.share_within_3sigma = 0.875;
   row.score.frames_beyond_5sigma = 3;
+  row.score.frames_beyond_5sigma_unseen = 2;
   row.score.max_z = 6.25;
   row.score.max_z_parameter = "yaw_r";
   row.score.first_frame_beyond_5sigma = 44;
@@ -328,6 +365,7 @@ TEST(CampaignCsv, RowsRoundTripAndFailedRowsKeepTheirColumns) {
   EXPECT_EQ(back[0].seed, 11u);
   EXPECT_EQ(back[0].score.share_within_3sigma, 0.875);
   EXPECT_EQ(back[0].score.frames_beyond_5sigma, 3);
+  EXPECT_EQ(back[0].score.frames_beyond_5sigma_unseen, 2);
   EXPECT_EQ(back[0].score.max_z_parameter, "yaw_r");
   EXPECT_EQ(back[0].score.first_frame_beyond_5sigma, 44);
   EXPECT_EQ(back[0].score.rmse[11], 0.012);
@@ -351,6 +389,8 @@ TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
     row.settings = {{"x", values[i].first}, {"kind", values[i].second}};
     row.score.share_within_3sigma = i == 1 ? 0.5 : 1.0;  // run 1 is not honest
     row.score.max_z = static_cast<double>(i);
+    if (i == 2 || i == 3) row.score.frames_beyond_5sigma = 10;  // run 3: 4 of them unseen
+    if (i == 3) row.score.frames_beyond_5sigma_unseen = 4;
     rows.push_back(row);
   }
   const std::vector<CampaignBucket> x = campaignBuckets(rows, "x");
@@ -367,11 +407,17 @@ TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
   EXPECT_EQ(kind[1].rows, (std::vector<int>{0, 2, 4}));
   const std::string summary = formatCampaignSummary(rows, 1);
   EXPECT_NE(
-      summary.find("Honest (share_within_3sigma >= 0.95 and frames_beyond_5sigma = 0): 4 of 5"),
+      summary.find("Honest (share_within_3sigma >= 0.95 and frames_beyond_5sigma = 0): 2 of 5"),
       std::string::npos)
       << summary;
-  // The worst run listed first is the one that is not honest, though run 4 has a larger max_z.
-  EXPECT_NE(summary.find("run 1  seed 0  NOT honest"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("Frames beyond 5 sigma: 20 in 2 runs; of them 4 in 1 runs in an unseen "
+                         "change"),
+            std::string::npos)
+      << summary;
+  // The worst run listed first is the one that is not honest with the largest max_z, though
+  // run 4 has a larger one; its frames beyond 5 sigma with those in an unseen change.
+  EXPECT_NE(summary.find("run 3  seed 0  NOT honest"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("frames_beyond_5sigma 10 (unseen 4)"), std::string::npos) << summary;
   EXPECT_EQ(summary.find("run 4  seed"), std::string::npos) << summary;
 }
 
@@ -730,6 +776,7 @@ TEST(Campaign, FourRunsOf100FramesWriteTheDocumentedColumnsAndResume) {
                                        "frames",
                                        "share_within_3sigma",
                                        "frames_beyond_5sigma",
+                                       "frames_beyond_5sigma_unseen",
                                        "max_z",
                                        "max_z_parameter",
                                        "first_frame_beyond_5sigma",

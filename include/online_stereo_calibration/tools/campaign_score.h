@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "online_stereo_calibration/core/sim/measurement_scenario.h"
 #include "online_stereo_calibration/core/sim/scenario_runner.h"
 
 namespace osc {
@@ -25,6 +26,11 @@ struct CampaignScore {
   double share_within_3sigma = 0.0;
   /// Frames >= kCampaignFirstScoredFrame with some |error| > 5 sigma.
   int frames_beyond_5sigma = 0;
+  /// Of those, the frames in an unseen change (unseenChangeSpans): the calibration changed
+  /// while nothing could be tracked and nothing has been tracked since, so no estimator
+  /// could know of it yet. They still count above (a run with them is not honest); this
+  /// tells them apart from the filter's own.
+  int frames_beyond_5sigma_unseen = 0;
   /// Largest z over those frames and parameters ...
   double max_z = 0.0;
   /// ... and its parameter's name (xl .. yaw_r).
@@ -43,8 +49,15 @@ struct CampaignScore {
 };
 
 /// Scores a run's per-frame results (in frame order; at least one frame from
-/// kCampaignFirstScoredFrame on). @throws std::invalid_argument otherwise.
-CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames);
+/// kCampaignFirstScoredFrame on); frames within @p unseen are also counted in
+/// frames_beyond_5sigma_unseen. @throws std::invalid_argument otherwise.
+CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames,
+                               const std::vector<FrameSpan>& unseen = {});
+
+/// The frames in which the scenario's calibration change (its step) is unseen: from the
+/// step's frame to the end of the blind stretch (MeasurementScenario::blind_frames) it falls
+/// in. Empty when there is no step or it falls where frames are tracked.
+std::vector<FrameSpan> unseenChangeSpans(const MeasurementScenario& scenario);
 
 /// The parameter names in interface order (xl, yl, zl, roll_l, ..., yaw_r).
 const std::array<std::string, 12>& campaignParameterNames();

@@ -123,7 +123,7 @@ CampaignRow runCampaignRun(const CampaignRunSpec& spec, const EstimatorConfig& c
   CampaignRow row;
   try {
     const std::vector<ScenarioFrameResult> results = simulateCampaignRun(spec, config, images);
-    row.score = scoreCampaignRun(results);
+    row.score = scoreCampaignRun(results, unseenChangeSpans(spec.scenario));
   } catch (const std::exception& e) {
     row = failedCampaignRow(spec.run, spec.seed, spec.scenario.frames, spec.settings, e.what());
   }

@@ -21,6 +21,7 @@ const std::vector<std::string>& scoreColumns() {
                                                    "frames",
                                                    "share_within_3sigma",
                                                    "frames_beyond_5sigma",
+                                                   "frames_beyond_5sigma_unseen",
                                                    "max_z",
                                                    "max_z_parameter",
                                                    "first_frame_beyond_5sigma",
@@ -68,7 +69,7 @@ CampaignRow failedCampaignRow(int run, unsigned seed, int frames, const Campaign
   const double nan = std::numeric_limits<double>::quiet_NaN();
   row.score.share_within_3sigma = row.score.max_z = row.score.nees_mean = nan;
   row.score.time_ms_median = nan;
-  row.score.frames_beyond_5sigma = -1;
+  row.score.frames_beyond_5sigma = row.score.frames_beyond_5sigma_unseen = -1;
   row.score.max_z_parameter = "-";
   row.score.rmse.fill(nan);
   row.settings = settings;
@@ -98,9 +99,9 @@ std::string formatCampaignCsvLine(const CampaignRow& row,
   const CampaignScore& s = row.score;
   std::ostringstream line;
   line << row.run << ',' << row.seed << ',' << row.frames << ',' << number(s.share_within_3sigma)
-       << ',' << s.frames_beyond_5sigma << ',' << number(s.max_z) << ',' << s.max_z_parameter << ','
-       << s.first_frame_beyond_5sigma << ',' << number(s.nees_mean) << ',' << s.converged_frame
-       << ',' << number(s.time_ms_median);
+       << ',' << s.frames_beyond_5sigma << ',' << s.frames_beyond_5sigma_unseen << ','
+       << number(s.max_z) << ',' << s.max_z_parameter << ',' << s.first_frame_beyond_5sigma << ','
+       << number(s.nees_mean) << ',' << s.converged_frame << ',' << number(s.time_ms_median);
   for (double r : s.rmse) line << ',' << number(r);
   for (size_t i = 0; i < setting_names.size(); ++i) {
     line << ',';
@@ -166,6 +167,7 @@ std::vector<CampaignRow> parseCampaignCsv(const std::string& text, const std::st
     row.frames = static_cast<int>(integer(column++));
     row.score.share_within_3sigma = real(column++);
     row.score.frames_beyond_5sigma = static_cast<int>(integer(column++));
+    row.score.frames_beyond_5sigma_unseen = static_cast<int>(integer(column++));
     row.score.max_z = real(column++);
     row.score.max_z_parameter = f[column++];
     row.score.first_frame_beyond_5sigma = static_cast<int>(integer(column++));

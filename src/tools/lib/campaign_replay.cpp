@@ -45,7 +45,8 @@ CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& o
   };
   CampaignRow row;
   try {
-    row.score = scoreCampaignRun(simulateCampaignRun(spec, inputs.config, inputs.images, on_frame));
+    row.score = scoreCampaignRun(simulateCampaignRun(spec, inputs.config, inputs.images, on_frame),
+                                 unseenChangeSpans(spec.scenario));
   } catch (const std::exception& e) {
     row = failedCampaignRow(run, spec.seed, inputs.frames, spec.settings, e.what());
   }

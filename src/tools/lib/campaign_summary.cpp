@@ -102,11 +102,16 @@ std::vector<CampaignBucket> campaignBuckets(const std::vector<CampaignRow>& rows
 std::string formatCampaignSummary(const std::vector<CampaignRow>& rows, int worst) {
   std::ostringstream text;
   int ok = 0, honest = 0;
+  int runs_beyond = 0, frames_beyond = 0, runs_unseen = 0, frames_unseen = 0;
   std::vector<double> shares, max_z, nees, times, converged;
   for (const CampaignRow& row : rows) {
     ok += row.ok();
     honest += row.honest();
     if (!row.ok()) continue;
+    runs_beyond += row.score.frames_beyond_5sigma > 0;
+    frames_beyond += row.score.frames_beyond_5sigma;
+    runs_unseen += row.score.frames_beyond_5sigma_unseen > 0;
+    frames_unseen += row.score.frames_beyond_5sigma_unseen;
     shares.push_back(row.score.share_within_3sigma);
     max_z.push_back(row.score.max_z);
     nees.push_back(row.score.nees_mean);
@@ -118,6 +123,10 @@ std::string formatCampaignSummary(const std::vector<CampaignRow>& rows, int wors
        << "Honest (share_within_3sigma >= " << kHonestShare
        << " and frames_beyond_5sigma = 0): " << honest << " of " << n << " (" << percent(honest, n)
        << ")\n"
+       << "Frames beyond 5 sigma: " << frames_beyond << " in " << runs_beyond << " runs; of them "
+       << frames_unseen << " in " << runs_unseen
+       << " runs in an unseen change (frames_beyond_5sigma_unseen: the calibration changed in a "
+          "blind stretch, nothing tracked since)\n"
        << "Medians over the runs that ran: share_within_3sigma " << format("%.3f", median(shares))
        << ", max_z " << format("%.2f", median(max_z)) << ", nees_mean "
        << format("%.2f", median(nees)) << ", time per frame " << format("%.2f", median(times))
@@ -135,8 +144,9 @@ std::string formatCampaignSummary(const std::vector<CampaignRow>& rows, int wors
     text << "  run " << row.run << "  seed " << row.seed << "  "
          << (row.ok() ? (row.honest() ? "honest" : "NOT honest") : row.status)
          << "  share_within_3sigma " << format("%.3f", row.score.share_within_3sigma)
-         << "  frames_beyond_5sigma " << row.score.frames_beyond_5sigma << "  max_z "
-         << format("%.2f", row.score.max_z) << " (" << row.score.max_z_parameter << ")"
+         << "  frames_beyond_5sigma " << row.score.frames_beyond_5sigma << " (unseen "
+         << row.score.frames_beyond_5sigma_unseen << ")  max_z " << format("%.2f", row.score.max_z)
+         << " (" << row.score.max_z_parameter << ")"
          << "  nees_mean " << format("%.2f", row.score.nees_mean) << "\n    ";
     for (const auto& [name, value] : row.settings) text << name << "=" << value << " ";
     text << "\n";
