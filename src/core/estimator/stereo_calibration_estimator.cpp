@@ -392,12 +392,9 @@ bool StereoCalibrationEstimator::reopenIfOffEpipolarLines(std::vector<PointMeasu
   candidates->insert(candidates->end(), tracked->begin(), tracked->end());
   tracked->clear();
   report->right_camera_off_epipolar_lines = true;
-  const std::string where =
-      config_.epipolar_knock_pairs == 1
-          ? std::string("this image pair")
-          : std::to_string(config_.epipolar_knock_pairs) + " image pairs in a row";
-  report->warnings.push_back("the stereo pairs left x_camr's epipolar lines in " + where + " (" +
-                             evidence.summary() +
+  report->warnings.push_back("the stereo pairs left x_camr's epipolar lines in " +
+                             std::to_string(config_.epipolar_knock_pairs) +
+                             " image pairs in a row (" + evidence.summary() +
                              "): x_camr's rotation re-opened (a knocked right camera?), "
                              "points re-initialised");
   return true;
