@@ -392,9 +392,12 @@ bool StereoCalibrationEstimator::reopenIfOffEpipolarLines(std::vector<PointMeasu
   candidates->insert(candidates->end(), tracked->begin(), tracked->end());
   tracked->clear();
   report->right_camera_off_epipolar_lines = true;
-  report->warnings.push_back("the stereo pairs left x_camr's epipolar lines in " +
-                             std::to_string(config_.epipolar_knock_pairs) +
-                             " image pairs in a row (" + evidence.summary() +
+  const std::string where =
+      config_.epipolar_knock_pairs == 1
+          ? std::string("this image pair")
+          : std::to_string(config_.epipolar_knock_pairs) + " image pairs in a row";
+  report->warnings.push_back("the stereo pairs left x_camr's epipolar lines in " + where + " (" +
+                             evidence.summary() +
                              "): x_camr's rotation re-opened (a knocked right camera?), "
                              "points re-initialised");
   return true;
@@ -533,8 +536,15 @@ std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
   StereoExtrinsics seeded = filter_.extrinsics();
   seeded.T_caml_camr = T_caml_camr;
   filter_.reset(seeded, withRightCamera(filter_.covariance(), covariance));
-  guess_.T_caml_camr = T_caml_camr;
-  guess_covariance_ = withRightCamera(Matrix12d(guess_covariance_), covariance);
+  // Only a start's seed becomes the guess a hand-eye restart returns to. One after a
+  // re-opening keeps the translation the filter learned before it, which, before the hand-eye
+  // has found x_caml's rotation, was learned with x_caml far off: a backward camera guessed
+  // forward had yr 9 sigma off when its first pair off the epipolar lines re-opened x_camr,
+  // and the restart two pairs later kept it (HandEyeStart image-level test).
+  if (start) {
+    guess_.T_caml_camr = T_caml_camr;
+    guess_covariance_ = withRightCamera(Matrix12d(guess_covariance_), covariance);
+  }
   forgetBaselineEvidence();  // its disparities were measured with the old x_camr
   has_previous_frame_ = false;
   mounting_.forgetFrame();
