@@ -29,6 +29,13 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
+/// The value of the setting column @p name (campaignSettingNames), "" if there is none.
+std::string settingOf(const CampaignSettings& settings, const std::string& name) {
+  for (const auto& [key, value] : settings)
+    if (key == name) return value;
+  return "";
+}
+
 std::string parseError(const std::string& yaml) {
   try {
     parseCampaignRanges(yaml, "test.yaml");
@@ -204,10 +211,10 @@ TEST(CampaignDraw, ValuesStayInTheirRangesAndRepeatWithTheSeed) {
     const std::vector<std::string> names = campaignSettingNames(true);
     ASSERT_EQ(spec.settings.size(), names.size());
     for (size_t i = 0; i < names.size(); ++i) EXPECT_EQ(spec.settings[i].first, names[i]);
-    lenses.insert(spec.settings[4].second);
-    mountings.insert(spec.settings[6].second);
-    motions.insert(spec.settings[8].second);
-    events.insert(spec.settings[22].second);
+    lenses.insert(settingOf(spec.settings, "lens"));
+    mountings.insert(settingOf(spec.settings, "mounting"));
+    motions.insert(settingOf(spec.settings, "motion"));
+    events.insert(settingOf(spec.settings, "event"));
   }
   EXPECT_EQ(lenses, (std::set<std::string>{"pinhole", "plumb_bob", "equidistant"}));
   EXPECT_EQ(mountings, (std::set<std::string>{"forward", "sideways_left", "sideways_right"}));
@@ -239,7 +246,7 @@ TEST(CampaignDraw, RecordedTrajectoryStretchLiesInTheFile) {
     EXPECT_DOUBLE_EQ(spec.scenario.recorded_trajectory->firstStamp(), 100.0);
     EXPECT_GE(spec.scenario.recorded_start_offset, 0.0);
     EXPECT_LE(spec.scenario.recorded_start_offset + 30.0, 100.0);
-    EXPECT_EQ(spec.settings[9].second, "line");
+    EXPECT_EQ(settingOf(spec.settings, "trajectory"), "line");
   }
   // A drive longer than the recording: the run cannot be made, the error names the file, the
   // settings are all there.
@@ -466,8 +473,8 @@ TEST(Campaign, AYawStepOfTheLeftCameraOnAFlatRoadIsDetectedThoughZlStaysOpen) {
   // was re-opened and yaw_l stayed ~100 sigma off for the rest of the drive.
   const CampaignRunSpec spec = shippedRun(121);
   ASSERT_TRUE(spec.error.empty()) << spec.error;
-  ASSERT_EQ(spec.settings[22].second, "caml_yaw_step");  // event
-  ASSERT_EQ(spec.settings[8].second, "urban");           // motion
+  ASSERT_EQ(settingOf(spec.settings, "event"), "caml_yaw_step");
+  ASSERT_EQ(settingOf(spec.settings, "motion"), "urban");
   EstimatorConfig config;
   const CampaignRow shipped = runCampaignRun(spec, config, false);
   config.filter.jump_settle_time = 1e6;  // translations must settle first, as before
@@ -496,7 +503,7 @@ TEST(Campaign, ADronesForwardVelocityErrorIsEstimatedNotTakenForAYawOfTheRightCa
   // the points, which a vergence of the right camera explains too.
   const CampaignRunSpec spec = shippedRun(40, "kind: {none: 1}");
   ASSERT_TRUE(spec.error.empty()) << spec.error;
-  ASSERT_EQ(spec.settings[8].second, "recorded");  // motion
+  ASSERT_EQ(settingOf(spec.settings, "motion"), "recorded");
   ASSERT_GT(EstimatorConfig().filter.odometry_forward_velocity_bias_sigma, 0);
   const CampaignRow shipped = runShipped(spec);
   const CampaignRow lateral_only =
@@ -580,13 +587,8 @@ TEST(Campaign, AStandingCarsOdometryNoiseIsNotTakenForParallax) {
   // (FilterConfig::motion_relinearizations) keeps it honest.
   const CampaignRunSpec spec = shippedRun(106);
   ASSERT_TRUE(spec.error.empty()) << spec.error;
-  const auto setting = [&](const std::string& name) {
-    for (const auto& [key, value] : spec.settings)
-      if (key == name) return value;
-    return std::string();
-  };
-  ASSERT_EQ(setting("motion"), "urban");
-  ASSERT_EQ(setting("stops"), "1");
+  ASSERT_EQ(settingOf(spec.settings, "motion"), "urban");
+  ASSERT_EQ(settingOf(spec.settings, "stops"), "1");
   ASSERT_GT(EstimatorConfig().filter.motion_relinearizations, 0);
   const CampaignRow shipped = runShipped(spec);
   const CampaignRow without =
@@ -622,19 +624,19 @@ TEST(Campaign, AKnockTooSmallToGateOutPointsIsCaughtByItsScoreInTwoUpdates) {
   ASSERT_TRUE(score_only.ok()) << score_only.status;
   ASSERT_TRUE(without.ok()) << without.status;
   EXPECT_LE(score_only.score.frames_beyond_5sigma, 2) << scoreText(score_only);
-  // Not before the knock (-1: none, since session 23's epipolar_knock_pairs 1).
+  // Not before the knock (-1: none, since session 24's epipolar_knock_pairs 1).
   EXPECT_TRUE(shipped.score.first_frame_beyond_5sigma == -1 ||
               shipped.score.first_frame_beyond_5sigma >= 339)
       << scoreText(shipped);
-  EXPECT_LE(shipped.score.frames_beyond_5sigma, 2);   // measured: 1 (0 since session 23)
+  EXPECT_LE(shipped.score.frames_beyond_5sigma, 2);   // measured: 1 (0 since session 24)
   EXPECT_GT(without.score.frames_beyond_5sigma, 20);  // measured: 30
 }
 
 TEST(Campaign, AKnocksFirstPairOffTheEpipolarLinesReopensTheRightCamera) {
   // Run 23 of the shipped ranges again (x_camr knocked by 0.15 deg at frame 339). The pairs
   // leave the epipolar lines at frame 339 already (statistic 48 for a bound of 33). Waiting
-  // for a second such pair (epipolar_knock_pairs 2, sessions 21-22) left that frame's
-  // estimate roll_r 33 sigma off; re-opened on the first (the default since session 23), no
+  // for a second such pair (epipolar_knock_pairs 2, sessions 21-23) left that frame's
+  // estimate roll_r 33 sigma off; re-opened on the first (the default since session 24), no
   // frame is beyond 5 sigma.
   const CampaignRunSpec spec = shippedRun(23);
   ASSERT_TRUE(spec.error.empty()) << spec.error;
@@ -657,7 +659,7 @@ TEST(Campaign, ASteadyDriftOfTheRightCameraIsFollowedByItsRateWithoutALagBeyondI
   // drift beyond its sigma: 83 % of the frames within 3 sigma, 5.2 sigma at worst.
   const CampaignRunSpec spec = shippedRun(28);
   ASSERT_TRUE(spec.error.empty()) << spec.error;
-  ASSERT_EQ(spec.settings[8].second, "urban");  // motion
+  ASSERT_EQ(settingOf(spec.settings, "motion"), "urban");
   ASSERT_GT(EstimatorConfig().filter.camr_rotation_drift_rate_sigma, 0);
   const CampaignRow shipped = runShipped(spec);
   const CampaignRow walk_only =
@@ -680,7 +682,7 @@ TEST(Campaign, AStartFarFromTheTruthIsTemperedNotLockedIn) {
   // honest untempered.)
   const CampaignRunSpec spec = shippedRun(11);
   ASSERT_TRUE(spec.error.empty()) << spec.error;
-  ASSERT_EQ(spec.settings[8].second, "urban");  // motion
+  ASSERT_EQ(settingOf(spec.settings, "motion"), "urban");
   ASSERT_GT(EstimatorConfig().filter.max_sigma_shrink_per_update, 1.0);
   // Untempered, the test of the pairs against x_camr's epipolar lines (epipolar_knock_*,
   // session 21) rescues it too: the collapsed x_camr's lines are off the next pairs and its
@@ -715,7 +717,7 @@ TEST(Campaign, AJerkyRigWithATimeOffsetIsNotTakenForAKnock) {
   // the motion noise (time_offset_model_noise), it is honest.
   const CampaignRunSpec spec = shippedRun(147);
   ASSERT_TRUE(spec.error.empty()) << spec.error;
-  ASSERT_EQ(spec.settings[9].second, "udel_gore_rep103");  // trajectory
+  ASSERT_EQ(settingOf(spec.settings, "trajectory"), "udel_gore_rep103");
   const CampaignRow shipped = runShipped(spec);
   const CampaignRow first_order_only = runShipped(spec, [](FilterConfig* c) {
     c->read_odometry_at_offset = 0;
@@ -734,7 +736,7 @@ TEST(Campaign, TheOdometryReadAtTheEstimatedOffsetKeepsAWalkingRigHonest) {
   // its IMU), only the estimate's error is left to the first-order correction.
   const CampaignRunSpec spec = shippedRun(189);
   ASSERT_TRUE(spec.error.empty()) << spec.error;
-  ASSERT_EQ(spec.settings[9].second, "udel_gore_rep103");
+  ASSERT_EQ(settingOf(spec.settings, "trajectory"), "udel_gore_rep103");
   ASSERT_EQ(EstimatorConfig().filter.read_odometry_at_offset, 1);
   const CampaignRow shipped = runShipped(spec);
   const CampaignRow at_stamps =
@@ -759,7 +761,7 @@ TEST(Campaign, TheThinEvidenceFloorKeepsAGuessThatTriangulatesAlmostNoPointOpen)
   // while slow (session 22: with it 70 frames beyond 5 sigma).
   const CampaignRunSpec spec = shippedRun(24);
   ASSERT_TRUE(spec.error.empty()) << spec.error;
-  ASSERT_EQ(spec.settings[6].second, "backward");  // mounting
+  ASSERT_EQ(settingOf(spec.settings, "mounting"), "backward");
   ASSERT_EQ(EstimatorConfig().filter.thin_evidence_points, 0);
   const auto no_epipolar_test = [](FilterConfig* c) {
     c->epipolar_knock_false_alarm = 0.0;
@@ -936,7 +938,7 @@ TEST(Campaign, FailedRunsAreRecordedNotFatal) {
   ASSERT_EQ(rows.size(), 6u);
   int failed = 0;
   for (const CampaignRow& row : rows) {
-    const bool recorded = !row.settings.empty() && row.settings[8].second == "recorded";
+    const bool recorded = settingOf(row.settings, "motion") == "recorded";
     EXPECT_EQ(row.ok(), !recorded) << row.status;
     if (row.ok()) continue;
     ++failed;

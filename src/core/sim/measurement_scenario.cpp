@@ -202,10 +202,13 @@ std::vector<std::string> MeasurementScenario::validate() const {
   return p.take();
 }
 
+bool inFrameSpans(const std::vector<FrameSpan>& spans, int frame) {
+  return std::any_of(spans.begin(), spans.end(),
+                     [frame](const FrameSpan& span) { return span.contains(frame); });
+}
+
 bool MeasurementScenario::isBlindFrame(int frame) const {
-  return std::any_of(blind_frames.begin(), blind_frames.end(), [frame](const FrameSpan& span) {
-    return frame >= span.first && frame <= span.last;
-  });
+  return inFrameSpans(blind_frames, frame);
 }
 
 Vector12d MeasurementScenario::truthParametersAt(int frame) const {

@@ -27,19 +27,13 @@ const std::array<std::string, 12>& campaignParameterNames() {
 std::vector<FrameSpan> unseenChangeSpans(const MeasurementScenario& scenario) {
   if (scenario.step.isZero() || scenario.step_frame < 0) return {};
   for (const FrameSpan& blind : scenario.blind_frames) {
-    if (scenario.step_frame >= blind.first && scenario.step_frame <= blind.last)
-      return {FrameSpan{scenario.step_frame, blind.last}};
+    if (blind.contains(scenario.step_frame)) return {FrameSpan{scenario.step_frame, blind.last}};
   }
   return {};
 }
 
 CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames,
                                const std::vector<FrameSpan>& unseen) {
-  const auto isUnseen = [&](int frame) {
-    for (const FrameSpan& s : unseen)
-      if (frame >= s.first && frame <= s.last) return true;
-    return false;
-  };
   CampaignScore score;
   const double inf = std::numeric_limits<double>::infinity();
   int scored = 0, within = 0;
@@ -66,7 +60,7 @@ CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames,
     within += all_within;
     if (some_beyond) {
       ++score.frames_beyond_5sigma;
-      score.frames_beyond_5sigma_unseen += isUnseen(f.frame);
+      score.frames_beyond_5sigma_unseen += inFrameSpans(unseen, f.frame);
       if (score.first_frame_beyond_5sigma < 0) score.first_frame_beyond_5sigma = f.frame;
     }
     nees_sum += f.nees / 12.0;

@@ -26,7 +26,12 @@ struct TimeSpan {
 struct FrameSpan {
   int first = 0;  ///< >= 0
   int last = 0;   ///< >= first
+
+  bool contains(int frame) const { return frame >= first && frame <= last; }
 };
+
+/// Whether @p frame lies in one of @p spans.
+bool inFrameSpans(const std::vector<FrameSpan>& spans, int frame);
 
 /// Smooth analytic vehicle motion (see VehicleTrajectory): constant forward speed along a
 /// sinusoidally steered path, plus sinusoidal roll, pitch and heave of the body.
