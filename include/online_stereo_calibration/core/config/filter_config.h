@@ -138,10 +138,10 @@ struct FilterConfig {
   /// which the new points' gating blamed on x_caml (default campaign run 102: yaw_r 193
   /// sigma off), is found in the first pair after it. 0 = off.
   double epipolar_knock_false_alarm = 1e-6;
-  /// 1 since session 23: with 2, each knock's first pair was tens of sigmas off (default
+  /// 1 since session 24: with 2, each knock's first pair was tens of sigmas off (default
   /// campaign runs 2, 23, 57, 180: 26-126 sigma for that frame); with 1 the default campaign
   /// has 163 instead of 156 of 200 runs honest and 192 instead of 285 frames beyond 5 sigma
-  /// (docs/RESULTS.md "Session 23"). Widening x_camr's rotation on the first pair, points
+  /// (docs/RESULTS.md "Session 24"). Widening x_camr's rotation on the first pair, points
   /// kept, instead of re-opening was worse: yaw_r, which one pair hardly shows, then locked
   /// 12-14 sigma off after real knocks (runs 62, 139).
   int epipolar_knock_pairs = 1;
