@@ -114,9 +114,10 @@ class StereoCalibrationEstimator {
   /// a re-opening, FilterConfig::stereo_fit_start): its mean becomes @p T_caml_camr and its tangent
   /// covariance block @p covariance (m, rad; [dt, dtheta] as the filter's), uncorrelated with
   /// x_caml, which keeps its estimate and covariance. At a start the guess takes the same
-  /// x_camr (a later hand-eye restart keeps it); after a re-opening it does not. Every point is forgotten and the odometry states
-  /// (the time offset) start from their priors. Re-linearised (relinearizeIfMoved) as after
-  /// a start if @p start, else as after a re-opening of x_camr. Returns the forgotten points.
+  /// x_camr (a later hand-eye restart keeps it); after a re-opening it does not. Every point is
+  /// forgotten and the odometry states (the time offset) start from their priors. Re-linearised
+  /// (relinearizeIfMoved) as after a start if @p start, else as after a re-opening of x_camr.
+  /// Returns the forgotten points.
   std::vector<PointId> reseedRightCamera(const Eigen::Isometry3d& T_caml_camr,
                                          const Matrix6d& covariance, bool start);
   /// Starts over from a new guess with the config's initial uncertainty.
