@@ -305,6 +305,18 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& co
   index_.clear();
 }
 
+void CalibrationFilter::restartCalibration(const Matrix12d& covariance) {
+  const MatrixXd kept = covariance_;
+  const Eigen::Vector3d velocity_bias = velocity_bias_, drift_rate = drift_rate_;
+  const double time_offset = time_offset_;
+  reset(extrinsics_, covariance);
+  const int n = persistentDim(), rest = n - layout::kCalibrationDim;
+  covariance_.bottomRightCorner(rest, rest) = kept.bottomRightCorner(rest, rest);
+  time_offset_ = time_offset;
+  velocity_bias_ = velocity_bias;
+  drift_rate_ = drift_rate;
+}
+
 std::string CalibrationFilter::checkMotion(const MotionIncrement& m) const {
   std::ostringstream why;
   const Eigen::Matrix3d R = m.T_prev_curr.linear();

@@ -100,6 +100,12 @@ class CalibrationFilter {
   /// odometry states start from their priors.
   /// @throws std::invalid_argument if the covariance is not finite, symmetric PD.
   void reset(const StereoExtrinsics& guess, const Matrix12d& covariance);
+  /// Re-linearises the calibration (StereoCalibrationEstimator's restart from the current
+  /// estimate): its tangent covariance becomes @p covariance, uncorrelated with the rest, and
+  /// every point is removed; the odometry states (time offset, velocity bias, x_camr's drift
+  /// rate) keep what they learned.
+  /// @throws std::invalid_argument if the covariance is not finite, symmetric PD.
+  void restartCalibration(const Matrix12d& covariance);
 
   /// Predicts with the measured motion (eq. 7-28) and corrects with the measurements
   /// (eq. 29-30). Tracked points without a measurement are removed (Sec. II-C), and so
