@@ -732,9 +732,11 @@ TEST(Campaign, AJerkyRigWithATimeOffsetIsNotTakenForAKnock) {
 
 TEST(Campaign, TheOdometryReadAtTheEstimatedOffsetKeepsAWalkingRigHonest) {
   // Run 189: the walking rig again, a side camera, odometry 30 ms ahead. Read at the image
-  // stamps, even with the correction's error in the motion noise, roll_l ends 7 sigma off
-  // (171 frames beyond 5 sigma); read at the stamps minus the estimated offset (as VINS reads
-  // its IMU), only the estimate's error is left to the first-order correction.
+  // stamps, even with the correction's error in the motion noise, roll_l ended 7 sigma off
+  // (171 frames beyond 5 sigma; since a re-linearisation restart keeps the learned time
+  // offset, pitch_l 6.5 sigma, 62 frames, 61 % within 3 sigma); read at the stamps minus the
+  // estimated offset (as VINS reads its IMU), only the estimate's error is left to the
+  // first-order correction.
   const CampaignRunSpec spec = shippedRun(189);
   ASSERT_TRUE(spec.error.empty()) << spec.error;
   ASSERT_EQ(settingOf(spec.settings, "trajectory"), "udel_gore_rep103");
@@ -745,7 +747,8 @@ TEST(Campaign, TheOdometryReadAtTheEstimatedOffsetKeepsAWalkingRigHonest) {
   ASSERT_TRUE(shipped.ok()) << shipped.status;
   ASSERT_TRUE(at_stamps.ok()) << at_stamps.status;
   EXPECT_TRUE(shipped.honest()) << scoreText(shipped);
-  EXPECT_GT(at_stamps.score.frames_beyond_5sigma, 100);  // measured: 171
+  EXPECT_GT(at_stamps.score.frames_beyond_5sigma, 30) << scoreText(at_stamps);  // measured: 62
+  EXPECT_LT(at_stamps.score.share_within_3sigma, 0.8) << scoreText(at_stamps);  // measured: 0.61
 }
 
 TEST(Campaign, TheThinEvidenceFloorKeepsAGuessThatTriangulatesAlmostNoPointOpen) {
