@@ -576,7 +576,8 @@ TEST(Campaign, AKnockInsideABlindStretchIsFoundOnTheEpipolarLinesNotBlamedOnTheL
   // What is left are the knock's blind frames (39) and yl's 5.0-5.5 sigma after a small rig's
   // start (6; 97 with epipolar_knock_pairs 2).
   EXPECT_LT(shipped.score.frames_beyond_5sigma, 200) << scoreText(shipped);  // measured: 45
-  EXPECT_GT(without.score.frames_beyond_5sigma, 300) << scoreText(without);  // measured: 331
+  // Without the test, 243 frames since session 26's far-move restart (331 before).
+  EXPECT_GT(without.score.frames_beyond_5sigma, 200) << scoreText(without);  // measured: 243
 }
 
 TEST(Campaign, AStandingCarsOdometryNoiseIsNotTakenForParallax) {
@@ -749,6 +750,30 @@ TEST(Campaign, TheOdometryReadAtTheEstimatedOffsetKeepsAWalkingRigHonest) {
   EXPECT_TRUE(shipped.honest()) << scoreText(shipped);
   EXPECT_GT(at_stamps.score.frames_beyond_5sigma, 30) << scoreText(at_stamps);  // measured: 62
   EXPECT_LT(at_stamps.score.share_within_3sigma, 0.8) << scoreText(at_stamps);  // measured: 0.61
+}
+
+TEST(Campaign, AStartThatMovedFarIsRestartedThoughItsInnovationsLookAsExpected) {
+  // A start's wide sigmas dominate the expected innovations, so a linearisation far off need
+  // not show in them. Run 143 of the shipped ranges (a sideways camera on a recorded EuRoC
+  // drone path, the baseline guessed 21 % short, x_camr's angles 4.2 deg off) moved 2.1 start
+  // sigmas by frame 30 with its innovations at 0.96 of their expected size, under the 1.05
+  // gate, and locked yr 11 sigma off (15 frames beyond 5 sigma) until the next check.
+  // Run 7 (a backward camera, the baseline guessed 48 % short) moved 2.3 start sigmas at 0.99
+  // and sat beyond 3 sigma in 25 % of its frames. A move beyond 2 start sigmas restarts at the
+  // lower gate 0.95 at the first check after a start (relinearization_far_*); a start within
+  // its prior moves about 1 sigma (paper_offroad: 1.0-1.3, not restarted).
+  ASSERT_GT(EstimatorConfig().filter.relinearization_far_threshold, 0.0);
+  const auto no_far_gate = [](FilterConfig* c) { c->relinearization_far_threshold = 0.0; };
+  for (const int run : {143, 7}) {
+    const CampaignRunSpec spec = shippedRun(run);
+    ASSERT_TRUE(spec.error.empty()) << spec.error;
+    const CampaignRow shipped = runShipped(spec);
+    const CampaignRow without = runShipped(spec, no_far_gate);
+    ASSERT_TRUE(shipped.ok()) << shipped.status;
+    ASSERT_TRUE(without.ok()) << without.status;
+    EXPECT_TRUE(shipped.honest()) << "run " << run << ": " << scoreText(shipped);
+    EXPECT_FALSE(without.honest()) << "run " << run << ": " << scoreText(without);
+  }
 }
 
 TEST(Campaign, TheThinEvidenceFloorKeepsAGuessThatTriangulatesAlmostNoPointOpen) {

@@ -143,6 +143,12 @@ const std::vector<ParameterSpec>& filterParameterTable() {
       real("relinearization_nis", &C::relinearization_nis, 1.0, 0.0, 1e6,
            "... and the updates' mean NIS per measured coordinate over those frames was above "
            "this (1 = as expected)"),
+      real("relinearization_far_threshold", &C::relinearization_far_threshold, 1.0, 0.0, 100.0,
+           "a move of more than this many start sigmas restarts at the lower gate "
+           "relinearization_far_nis (a start's wide sigmas hide a far-off linearisation from "
+           "the innovations); until the first restart; 0 = off"),
+      real("relinearization_far_nis", &C::relinearization_far_nis, 1.0, 0.0, 1e6,
+           "the NIS gate of such a far move"),
       integer("max_relinearizations", &C::max_relinearizations, 0, 1000,
               "restarts at most after one start or re-opening"),
       real("max_sigma_shrink_per_update", &C::max_sigma_shrink_per_update, 1.0, 0.0, 1e6,

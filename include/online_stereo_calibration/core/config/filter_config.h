@@ -164,6 +164,14 @@ struct FilterConfig {
   /// positions (for which 1.15 was chosen): at 1.15 paper_offroad's 0.5 m / 10 deg x_caml
   /// start was not restarted and xl sat 3-4 sigma off for frames 40-90 (docs/RESULTS.md).
   double relinearization_nis = 1.05;
+  /// A move of more than this many start sigmas restarts at the lower innovation gate
+  /// relinearization_far_nis; 0 = off. A start's wide sigmas dominate the expected
+  /// innovations, so a linearisation far off need not show in them: default campaign run 143
+  /// moved 2.1 start sigmas by frame 30 at 0.96 of the expected innovations and locked yr 11
+  /// sigma off. A start within its prior moves about 1 sigma (paper_offroad: 1.0-1.3). Only
+  /// at the first check after a start or re-opening (the linearisation at the guess).
+  double relinearization_far_threshold = 2.0;
+  double relinearization_far_nis = 0.95;
   /// ... at most this many times after one start or re-opening.
   int max_relinearizations = 4;
   /// Largest factor by which one update may shrink a calibration parameter's 1 sigma; an
