@@ -104,7 +104,7 @@ void CalibrationNodelet::onInit() {
         nh.createTimer(ros::Duration(config_.ros.save_interval), [this](const ros::TimerEvent&) {
           std::string error;
           if (!saveCalibration(&error) && !error.empty()) {
-            NODELET_WARN("periodic save failed: %s", error.c_str());
+            NODELET_WARN("online_stereo_calibration: periodic save failed: %s", error.c_str());
           }
         });
   }

@@ -98,23 +98,29 @@ FilterConfig configOfTheDenseReference() {
   return config;
 }
 
+/// Moves the guess to 5 % of its distance from the truth (a mildly nonlinear regime: the two
+/// filters linearise with different sigma-point spreads, local 9-15 dimensions vs 2n+1 over
+/// all, which differ at second order), starts both filters there and adds the first frame's
+/// points to both.
+void startBoth(SmallProblem* problem, CalibrationFilter* structured, DenseCalibrationUkf* dense) {
+  const Vector12d truth = problem->truth.toParameters();
+  problem->guess =
+      StereoExtrinsics::fromParameters(truth + 0.05 * (problem->guess.toParameters() - truth));
+  structured->reset(problem->guess, guessCovariance(0.05));
+  dense->reset(problem->guess, guessCovariance(0.05));
+  for (const PointMeasurement& m : problem->measure(0, 0.3)) {
+    ASSERT_TRUE(structured->addPoint(m));
+    ASSERT_TRUE(dense->addPoint(m));
+  }
+}
+
 void expectFiltersAgree(MotionNoiseModel model) {
   SmallProblem problem(6, 6);
   FilterConfig config = configOfTheDenseReference();
   config.motion_noise_model = model;
   CalibrationFilter structured(config, problem.K);
   DenseCalibrationUkf dense(config, problem.K);
-  // A mildly nonlinear regime: the two filters linearise with different sigma-point
-  // spreads (local 9-15 dimensions vs 2n+1 over all 30), which differ at second order.
-  const Vector12d truth = problem.truth.toParameters();
-  problem.guess =
-      StereoExtrinsics::fromParameters(truth + 0.05 * (problem.guess.toParameters() - truth));
-  structured.reset(problem.guess, guessCovariance(0.05));
-  dense.reset(problem.guess, guessCovariance(0.05));
-  for (const PointMeasurement& m : problem.measure(0, 0.3)) {
-    ASSERT_TRUE(structured.addPoint(m));
-    ASSERT_TRUE(dense.addPoint(m));
-  }
+  ASSERT_NO_FATAL_FAILURE(startBoth(&problem, &structured, &dense));
   ASSERT_TRUE(structured.denseCovariance().isApprox(dense.covariance(), 1e-9));
   for (int k = 1; k < 6; ++k) {
     const auto measurements = problem.measure(k, 0.3);
@@ -168,15 +174,7 @@ std::pair<Vector12d, Vector12d> sigmasAfterADrift(double drift_scale) {
   config.camr_translation_drift *= drift_scale;
   CalibrationFilter structured(config, problem.K);
   DenseCalibrationUkf dense(config, problem.K);
-  const Vector12d truth = problem.truth.toParameters();
-  problem.guess =
-      StereoExtrinsics::fromParameters(truth + 0.05 * (problem.guess.toParameters() - truth));
-  structured.reset(problem.guess, guessCovariance(0.05));
-  dense.reset(problem.guess, guessCovariance(0.05));
-  for (const PointMeasurement& m : problem.measure(0, 0.3)) {
-    EXPECT_TRUE(structured.addPoint(m));
-    EXPECT_TRUE(dense.addPoint(m));
-  }
+  startBoth(&problem, &structured, &dense);
   for (int k = 1; k < 30; ++k) {
     const auto measurements = problem.measure(k, 0.3);
     EXPECT_TRUE(structured.step(problem.motion(k), measurements).accepted);

@@ -760,8 +760,8 @@ TEST(Campaign, AStartThatMovedFarIsRestartedThoughItsInnovationsLookAsExpected) 
   // gate, and locked yr 11 sigma off (15 frames beyond 5 sigma) until the next check.
   // Run 7 (a backward camera, the baseline guessed 48 % short) moved 2.3 start sigmas at 0.99
   // and sat beyond 3 sigma in 25 % of its frames. A move beyond 2 start sigmas restarts at the
-  // lower gate 0.95 at the first check after a start (relinearization_far_*); a start within
-  // its prior moves about 1 sigma (paper_offroad: 1.0-1.3, not restarted).
+  // lower gate 0.95 until the first restart after a start (relinearization_far_*); a start
+  // within its prior moves about 1 sigma (paper_offroad: 1.0-1.3, not restarted).
   ASSERT_GT(EstimatorConfig().filter.relinearization_far_threshold, 0.0);
   const auto no_far_gate = [](FilterConfig* c) { c->relinearization_far_threshold = 0.0; };
   for (const int run : {143, 7}) {

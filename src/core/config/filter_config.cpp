@@ -148,7 +148,8 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "relinearization_far_nis (a start's wide sigmas hide a far-off linearisation from "
            "the innovations); until the first restart; 0 = off"),
       real("relinearization_far_nis", &C::relinearization_far_nis, 1.0, 0.0, 1e6,
-           "the NIS gate of such a far move"),
+           "the NIS gate of such a far move, in place of relinearization_nis (below 1: "
+           "innovations a little smaller than the start's sigmas predict still restart)"),
       integer("max_relinearizations", &C::max_relinearizations, 0, 1000,
               "restarts at most after one start or re-opening"),
       real("max_sigma_shrink_per_update", &C::max_sigma_shrink_per_update, 1.0, 0.0, 1e6,

@@ -281,7 +281,26 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess) {
 }
 
 void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& covariance) {
-  last_prediction_.reset();
+  requireValidStartCovariance(covariance);
+  covariance_ = startCovariance(covariance);
+  time_offset_ = config_.initial_time_offset;
+  velocity_bias_.setZero();
+  drift_rate_.setZero();
+  startCalibration(guess);
+}
+
+void CalibrationFilter::restartCalibration(const Matrix12d& covariance) {
+  requireValidStartCovariance(covariance);
+  // The odometry states keep their means and covariance; the calibration is uncorrelated
+  // with them, as at a start.
+  const int rest = persistentDim() - layout::kCalibrationDim;
+  covariance_.topLeftCorner<12, 12>() = covariance;
+  covariance_.topRightCorner(layout::kCalibrationDim, rest).setZero();
+  covariance_.bottomLeftCorner(rest, layout::kCalibrationDim).setZero();
+  startCalibration(extrinsics_);
+}
+
+void CalibrationFilter::requireValidStartCovariance(const Matrix12d& covariance) {
   if (!covariance.allFinite() ||
       (covariance - covariance.transpose()).cwiseAbs().maxCoeff() >
           1e-9 * covariance.cwiseAbs().maxCoeff() ||
@@ -289,11 +308,11 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& co
     throw std::invalid_argument(
         "initial calibration covariance must be finite, symmetric and positive definite");
   }
+}
+
+void CalibrationFilter::startCalibration(const StereoExtrinsics& guess) {
+  last_prediction_.reset();
   extrinsics_ = guess;
-  covariance_ = startCovariance(covariance);
-  time_offset_ = config_.initial_time_offset;
-  velocity_bias_.setZero();
-  drift_rate_.setZero();
   previous_motions_.clear();
   excitation_.reset();
   monitor_.reset();
@@ -303,18 +322,6 @@ void CalibrationFilter::reset(const StereoExtrinsics& guess, const Matrix12d& co
   score_streak_ = 0;
   points_.clear();
   index_.clear();
-}
-
-void CalibrationFilter::restartCalibration(const Matrix12d& covariance) {
-  const MatrixXd kept = covariance_;
-  const Eigen::Vector3d velocity_bias = velocity_bias_, drift_rate = drift_rate_;
-  const double time_offset = time_offset_;
-  reset(extrinsics_, covariance);
-  const int n = persistentDim(), rest = n - layout::kCalibrationDim;
-  covariance_.bottomRightCorner(rest, rest) = kept.bottomRightCorner(rest, rest);
-  time_offset_ = time_offset;
-  velocity_bias_ = velocity_bias;
-  drift_rate_ = drift_rate;
 }
 
 std::string CalibrationFilter::checkMotion(const MotionIncrement& m) const {

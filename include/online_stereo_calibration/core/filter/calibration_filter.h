@@ -185,6 +185,11 @@ class CalibrationFilter {
     return config_.baseline_scaled_points != 0 ? T_caml_camr.translation().norm() : 1.0;
   }
   double pointScale() const { return pointScale(extrinsics_.T_caml_camr); }
+  /// @throws std::invalid_argument unless @p covariance is finite, symmetric and PD.
+  static void requireValidStartCovariance(const Matrix12d& covariance);
+  /// The part of a start common to reset() and restartCalibration(): the calibration's mean
+  /// becomes @p guess; points, monitors and streaks start over. The covariance is the caller's.
+  void startCalibration(const StereoExtrinsics& guess);
   /// Size of the persistent global error: calibration (12) + odometry states + x_camr's
   /// drift rate.
   int persistentDim() const { return layout::kCalibrationDim + odometry_dim_ + drift_rate_dim_; }
