@@ -23,6 +23,7 @@
 #include "online_stereo_calibration/core/frontend/front_end_config.h"
 #include "online_stereo_calibration/core/frontend/global_stereo_fit.h"
 #include "online_stereo_calibration/core/frontend/stereo_front_end.h"
+#include "online_stereo_calibration/core/geometry/camera_model.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
 #include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
 #include "online_stereo_calibration/tools/kitti_sequence.h"
@@ -258,9 +259,9 @@ std::pair<RobustMean, RobustMean> leftCameraAnglesFromTheImages(const KittiSeque
   cv::BFMatcher matcher(cv::NORM_HAMMING, true);
   CameraMotionConfig config;
   config.focal = sequence.left.fx;
+  const CameraModel camera(sequence.left);
   const auto normalised = [&](const cv::Point2f& p) {
-    return Eigen::Vector2d((p.x - sequence.left.cx) / sequence.left.fx,
-                           (p.y - sequence.left.cy) / sequence.left.fy);
+    return camera.pixelToNormalized(Eigen::Vector2d(p.x, p.y));
   };
   std::vector<double> pitches, yaws;
   std::vector<cv::KeyPoint> previous_keys;

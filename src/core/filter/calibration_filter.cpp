@@ -293,10 +293,11 @@ void CalibrationFilter::restartCalibration(const Matrix12d& covariance) {
   requireValidStartCovariance(covariance);
   // The odometry states keep their means and covariance; the calibration is uncorrelated
   // with them, as at a start.
-  const int rest = persistentDim() - layout::kCalibrationDim;
-  covariance_.topLeftCorner<12, 12>() = covariance;
-  covariance_.topRightCorner(layout::kCalibrationDim, rest).setZero();
-  covariance_.bottomLeftCorner(rest, layout::kCalibrationDim).setZero();
+  constexpr int n = layout::kCalibrationDim;
+  const int rest = persistentDim() - n;
+  covariance_.topLeftCorner<n, n>() = covariance;
+  covariance_.topRightCorner(n, rest).setZero();
+  covariance_.bottomLeftCorner(rest, n).setZero();
   startCalibration(extrinsics_);
 }
 
