@@ -462,6 +462,10 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
         warning.rfind("the stereo pairs left x_camr's epipolar lines", 0) == 0) {
       diagnostics_->recordProblem("right camera off its epipolar lines", warning);
     }
+    if (result.estimator.left_camera_reopened_after_gap &&
+        warning.rfind("x_caml re-opened", 0) == 0) {
+      diagnostics_->recordProblem("left camera re-opened after a stretch without points", warning);
+    }
     if (result.estimator.too_few_points && warning.rfind("too few points", 0) == 0) {
       diagnostics_->recordProblem("too few points to update", warning);
     }

@@ -428,9 +428,10 @@ TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
   EXPECT_EQ(summary.find("run 4  seed"), std::string::npos) << summary;
 }
 
-/// Run @p run (600 frames) of the shipped ranges (config/campaign.yaml), with the events'
-/// kinds replaced by @p events when given. An error in the spec if the file's events changed.
-CampaignRunSpec shippedRun(int run, const std::string& events = "") {
+/// Run @p run (of @p frames frames) of the shipped ranges (config/campaign.yaml), with the
+/// events' kinds replaced by @p events when given. An error in the spec if the file's events
+/// changed.
+CampaignRunSpec shippedRun(int run, const std::string& events = "", int frames = 600) {
   const std::string dir = std::string(OSC_SOURCE_DIR) + "/config";
   CampaignInputs inputs;
   inputs.ranges_text = readTextFile(dir + "/campaign.yaml");
@@ -445,7 +446,7 @@ CampaignRunSpec shippedRun(int run, const std::string& events = "") {
     inputs.ranges_text.replace(at, shipped.size(), events);
   }
   inputs.ranges = parseCampaignRanges(inputs.ranges_text, "campaign.yaml", dir);
-  inputs.frames = 600;
+  inputs.frames = frames;
   return drawCampaignRun(inputs, run);
 }
 
@@ -808,6 +809,42 @@ TEST(Campaign, TheThinEvidenceFloorKeepsAGuessThatTriangulatesAlmostNoPointOpen)
   EXPECT_TRUE(floored.honest()) << scoreText(floored);
   EXPECT_GT(without.score.frames_beyond_5sigma, 100);                       // measured: 435
   EXPECT_LT(shipped.score.frames_beyond_5sigma, 10) << scoreText(shipped);  // measured: 1
+}
+
+TEST(Campaign, AYawStepOfTheLeftCameraInABlindStretchIsReopenedWhenThePointsReturn) {
+  // Run 9 of the shipped ranges at 200 frames (as the image campaign draws them): a backward
+  // camera on an off-road drive, x_caml yawed by -2.5 deg at frame 88 inside a 3.7 s blind
+  // stretch. No tracked point outlives the stretch, so none gates out and the jump test sees
+  // nothing; after it the consistency monitor's x_caml statistic was 13-20 for a bound of
+  // 3.8, but the monitor holds x_caml for its first 20 s, and yaw_l stayed 13 -> 8 sigma off
+  // to the end. The first updates after the stretch now test x_caml and re-open it (frame
+  // 116): what is left are the blind frames and the three updates of the test.
+  const CampaignRunSpec spec = shippedRun(9, "", 200);
+  ASSERT_TRUE(spec.error.empty()) << spec.error;
+  ASSERT_EQ(settingOf(spec.settings, "event"), "caml_yaw_step");
+  ASSERT_GT(EstimatorConfig().filter.unobserved_gap, 0.0);
+  const CampaignRow shipped = runShipped(spec);
+  const CampaignRow without = runShipped(spec, [](FilterConfig* c) { c->unobserved_gap = 0.0; });
+  ASSERT_TRUE(shipped.ok()) << shipped.status;
+  ASSERT_TRUE(without.ok()) << without.status;
+  EXPECT_GE(shipped.score.first_frame_beyond_5sigma, 88);                    // not before the step
+  EXPECT_LT(shipped.score.frames_beyond_5sigma, 40) << scoreText(shipped);   // measured: 28
+  EXPECT_GT(shipped.score.share_within_3sigma, 0.8) << scoreText(shipped);   // measured: 0.84
+  EXPECT_GT(without.score.frames_beyond_5sigma, 100) << scoreText(without);  // measured: 112
+  EXPECT_LT(without.score.share_within_3sigma, 0.5) << scoreText(without);   // measured: 0.34
+
+  // The same drive without the step: the test after the blind stretch finds nothing, and the
+  // run is the same as with the test off.
+  const CampaignRunSpec still = shippedRun(9, "kind: {none: 1}", 200);
+  ASSERT_TRUE(still.error.empty()) << still.error;
+  const CampaignRow still_shipped = runShipped(still);
+  const CampaignRow still_without =
+      runShipped(still, [](FilterConfig* c) { c->unobserved_gap = 0.0; });
+  ASSERT_TRUE(still_shipped.ok()) << still_shipped.status;
+  ASSERT_TRUE(still_without.ok()) << still_without.status;
+  EXPECT_EQ(still_shipped.score.frames_beyond_5sigma, 0) << scoreText(still_shipped);
+  EXPECT_EQ(still_shipped.score.share_within_3sigma, still_without.score.share_within_3sigma);
+  EXPECT_EQ(still_shipped.score.rmse, still_without.score.rmse);
 }
 
 }  // namespace

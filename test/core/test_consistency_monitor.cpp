@@ -274,6 +274,33 @@ TEST(ConsistencyMonitor, HoldsTheVehicleToLeftBlockDuringStartUp) {
   EXPECT_GT(monitor.inflation(ConsistencyBlock::kVehicleToLeft), 1.0);
 }
 
+// forgetEvidence empties the window, so a shift seen after it is judged on its own updates,
+// and unlike clearWindow it does not restart the start-up hold.
+TEST(ConsistencyMonitor, ForgettingTheEvidenceKeepsTheHoldAndTheFactors) {
+  std::mt19937 rng(23);
+  const SyntheticUpdate u(&rng);
+  FilterConfig config = monitorConfig();
+  config.consistency_startup = 5.0;
+  ConsistencyMonitor monitor(config);
+  VectorXd shift = VectorXd::Zero(u.G);
+  shift.segment<6>(6) = 2.0 * u.P.diagonal().segment<6>(6).cwiseSqrt();  // x_camr 2 sigma off
+  for (int k = 0; k < 60; ++k) {  // 6 s: past the hold, x_camr's factor raised
+    const UpdateScores s = u.draw(&rng, shift);
+    monitor.addUpdate(0.1, &s);
+  }
+  ASSERT_FALSE(monitor.status().holding);
+  ASSERT_TRUE(monitor.status().exceeded[kCamr]);
+  const double factor = monitor.inflation(ConsistencyBlock::kLeftToRight);
+  ASSERT_GT(factor, 10.0);
+  monitor.forgetEvidence();
+  EXPECT_EQ(monitor.status().window_updates, 0);
+  EXPECT_FALSE(monitor.status().exceeded[kCamr]);
+  EXPECT_FALSE(monitor.status().holding);
+  EXPECT_DOUBLE_EQ(monitor.inflation(ConsistencyBlock::kLeftToRight), factor);
+  monitor.clearWindow();  // a re-opened block, by contrast, holds x_caml again
+  EXPECT_TRUE(monitor.status().holding);
+}
+
 TEST(ConsistencyMonitor, OffDoesNothing) {
   FilterConfig config = monitorConfig();
   config.consistency_window = 0.0;

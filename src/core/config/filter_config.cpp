@@ -222,6 +222,10 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "time for that factor to grow tenfold while the block's statistic is above its bound"),
       real("drift_inflation_relax_s", &C::drift_inflation_relax, 1.0, 0.0, 1e6,
            "time constant of the factor's logarithm relaxing to 0 once consistent (0 = at once)"),
+      real("unobserved_gap_s", &C::unobserved_gap, 1.0, 0.0, 1e6,
+           "a stretch this long without a point measured leaves the calibration unobserved; "
+           "after it x_caml is re-opened if the consistency monitor's x_caml statistic "
+           "exceeds its bound within consistency_window_s (0 = off)"),
       // --- hand-eye rotation at start (issue 14) ---
       integer("hand_eye_start", &C::hand_eye_start, 0, 1,
               "1: determine x_caml's rotation from the camera's and the vehicle's motion at the "
@@ -310,6 +314,7 @@ FilterConfig paperFilterConfig() {
   config.motion_excitation_window = 0.0;      // the paper linearises at the measured motion
   config.motion_relinearizations = 0;         // ... once
   config.consistency_window = 0.0;            // the paper's random walk is fixed
+  config.unobserved_gap = 0.0;                // ... and nothing tests it after a gap
   config.jump_score_false_alarm = 0.0;        // ... and its knocks found by gated points
   config.epipolar_knock_false_alarm = 0.0;    // ... only
   config.relinearization_frames = 0;          // the paper's filter runs on from its start

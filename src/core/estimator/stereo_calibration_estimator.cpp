@@ -304,7 +304,15 @@ FrameReport StereoCalibrationEstimator::processFrame(
       tracked.clear();
     }
     held_for_few_points_ = report.too_few_points;
+    const bool resumes_after_gap = config_.unobserved_gap > 0.0 &&
+                                   unobserved_time_ >= config_.unobserved_gap && !tracked.empty();
+    if (resumes_after_gap) {
+      // What the monitor saw before the stretch says nothing of what follows it.
+      filter_.forgetConsistencyEvidence();
+      gap_check_left_ = config_.consistency_window;
+    }
     report.step = filter_.step(motion, tracked);
+    countUnobservedTime(motion, report.step);
     if (!report.step.accepted) {
       // Without a usable motion the points cannot be predicted: start tracking afresh.
       report.motion_rejected = true;
@@ -323,6 +331,8 @@ FrameReport StereoCalibrationEstimator::processFrame(
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());
         anchorReopening(report.step.jump, config_.jump_translation_sigma,
                         config_.jump_rotation_sigma);
+      } else if (reopenLeftCameraAfterGap(motion, &report)) {
+        candidates.insert(candidates.end(), tracked.begin(), tracked.end());
       } else if (relinearizeIfMoved(&report)) {
         // Tracking starts afresh with the next pair, as after a start.
         candidates.clear();
@@ -509,6 +519,40 @@ bool StereoCalibrationEstimator::learnBaselineLength(
   return true;
 }
 
+void StereoCalibrationEstimator::countUnobservedTime(const MotionIncrement& motion,
+                                                     const StepReport& step) {
+  if (step.accepted && step.measurements_used > 0) {
+    unobserved_time_ = 0.0;
+  } else if (std::isfinite(motion.dt) && motion.dt > 0.0) {
+    unobserved_time_ += motion.dt;
+  }
+}
+
+bool StereoCalibrationEstimator::reopenLeftCameraAfterGap(const MotionIncrement& motion,
+                                                          FrameReport* report) {
+  if (!(gap_check_left_ > 0.0) || report->step.measurements_used == 0) return false;
+  gap_check_left_ -= motion.dt;
+  // A few updates at least: one update's score is dominated by its own noise.
+  constexpr int kLeastUpdates = 3;
+  const ConsistencyStatus& consistency = report->step.consistency;
+  const int caml = static_cast<int>(ConsistencyBlock::kVehicleToLeft);
+  if (!consistency.exceeded[caml] || consistency.window_updates < kLeastUpdates) return false;
+  gap_check_left_ = 0.0;
+  const std::vector<PointId> dropped = filter_.reopen(
+      JumpBlock::kVehicleToLeft, config_.jump_translation_sigma, config_.jump_rotation_sigma);
+  report->dropped.insert(report->dropped.end(), dropped.begin(), dropped.end());
+  anchorReopening(JumpBlock::kVehicleToLeft, config_.jump_translation_sigma,
+                  config_.jump_rotation_sigma);
+  report->left_camera_reopened_after_gap = true;
+  std::ostringstream message;
+  message << "x_caml re-opened: the updates after a stretch without points disagree with it "
+          << "(consistency statistic " << consistency.statistic[caml] << " > "
+          << consistency.bound[caml] << " over " << consistency.window_updates
+          << " updates; the mounting changed while nothing was seen?); points re-initialised";
+  report->warnings.push_back(message.str());
+  return true;
+}
+
 std::vector<PointId> StereoCalibrationEstimator::resetTracking() {
   std::vector<PointId> dropped;
   for (const PointEstimate& p : filter_.points()) dropped.push_back(p.id);
@@ -567,12 +611,18 @@ std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
   return dropped;
 }
 
-void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
-  guess_ = guess;
+void StereoCalibrationEstimator::forgetDriveEvidence() {
   forgetBaselineEvidence();
   held_for_few_points_ = false;
   pairs_off_epipolar_lines_ = 0;
   mounting_.clear();
+  unobserved_time_ = 0.0;
+  gap_check_left_ = 0.0;
+}
+
+void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
+  guess_ = guess;
+  forgetDriveEvidence();
   filter_.reset(guess);
   guess_covariance_ = filter_.covariance();
   has_previous_frame_ = false;
@@ -582,10 +632,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
                                        const Matrix12d& tangent_covariance) {
   guess_ = guess;
-  forgetBaselineEvidence();
-  held_for_few_points_ = false;
-  pairs_off_epipolar_lines_ = 0;
-  mounting_.clear();
+  forgetDriveEvidence();
   // The given covariance is one as estimate() reports it (a saved calibration): take out what
   // the odometry's scale adds there, so that save -> restore -> estimate() gives it back. If
   // that leaves it indefinite (a prior sharper than the odometry's scale allows, e.g. sigmas

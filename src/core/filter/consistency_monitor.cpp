@@ -196,6 +196,11 @@ void ConsistencyMonitor::clearWindow() {
   evaluate();
 }
 
+void ConsistencyMonitor::forgetEvidence() {
+  window_entries_.clear();
+  evaluate();
+}
+
 void ConsistencyMonitor::addUpdate(double dt, const UpdateScores* scores) {
   if (!enabled_) return;
   time_ += dt;

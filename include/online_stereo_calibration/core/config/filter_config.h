@@ -310,6 +310,12 @@ struct FilterConfig {
   double drift_inflation_decade = 2.0;
   /// s, time constant of the factor's logarithm relaxing to 0 once consistent.
   double drift_inflation_relax = 30.0;
+  /// s without a point measured (a dark or texture-poor stretch, a gap in the data) after
+  /// which the calibration counts as unobserved: a change of x_caml in such a stretch leaves
+  /// no tracked point to gate out, so the jump test cannot see it. Over the first
+  /// consistency_window_s of updates after it x_caml is re-opened (jump sigmas) if the
+  /// consistency monitor's x_caml statistic exceeds its bound. 0 = off.
+  double unobserved_gap = 2.0;
 
   /// Every problem found, each naming the parameter, its value and the allowed range.
   std::vector<std::string> validate() const;

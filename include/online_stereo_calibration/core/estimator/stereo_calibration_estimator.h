@@ -89,6 +89,11 @@ struct FrameReport {
   /// camera; the warning names the statistic and the indicated rotation); every point
   /// forgotten, this pair's initialised afresh.
   bool right_camera_off_epipolar_lines = false;
+  /// x_caml was re-opened after this pair's update: the first updates after a stretch of at
+  /// least FilterConfig::unobserved_gap_s without a point measured disagreed with it (the
+  /// consistency monitor's x_caml statistic above its bound; a change of the mounting while
+  /// nothing was seen); every point forgotten, this pair's initialised afresh.
+  bool left_camera_reopened_after_gap = false;
   std::vector<std::string> warnings;  ///< human-readable, one per problem
 };
 
@@ -207,6 +212,17 @@ class StereoCalibrationEstimator {
   /// than relinearization_threshold is restarted from the current estimate with the anchor's
   /// uncertainty; every point is dropped into report->dropped. True if it did.
   bool relinearizeIfMoved(FrameReport* report);
+  /// Counts the time without a point measured (FilterConfig::unobserved_gap_s): a rejected
+  /// motion or a step that used no measurement adds its dt, a step that used some ends it.
+  void countUnobservedTime(const MotionIncrement& motion, const StepReport& step);
+  /// Within consistency_window_s of updates after an unobserved stretch: if the consistency
+  /// monitor's x_caml statistic exceeds its bound, re-opens x_caml (jump sigmas; every point
+  /// dropped into report->dropped, FrameReport::left_camera_reopened_after_gap). True if it
+  /// did.
+  bool reopenLeftCameraAfterGap(const MotionIncrement& motion, FrameReport* report);
+  /// What a reset forgets besides the filter: the evidence on the baseline, the knock and
+  /// few-points streaks, the hand-eye pairs, the unobserved stretch.
+  void forgetDriveEvidence();
   /// The hand-eye start (mounting_from_motion.h): feeds the frame's motion pair; once the
   /// rotation is determined and far from x_caml's, starts the filter afresh from the guess
   /// with that rotation for x_caml's (its translation sigma at least
@@ -238,6 +254,10 @@ class StereoCalibrationEstimator {
   bool held_for_few_points_ = false;
   /// Pairs in a row whose stereo pairs contradicted x_camr's epipolar lines.
   int pairs_off_epipolar_lines_ = 0;
+  /// s without a point measured so far (countUnobservedTime).
+  double unobserved_time_ = 0.0;
+  /// s of updates left in which x_caml is tested after an unobserved stretch.
+  double gap_check_left_ = 0.0;
   LinearizationAnchor anchor_;
   /// The last start's guess and its tangent covariance (restartFromMotion starts from them).
   StereoExtrinsics guess_;

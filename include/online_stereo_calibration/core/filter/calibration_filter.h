@@ -161,6 +161,8 @@ class CalibrationFilter {
 
   /// The consistency monitor's state: per-block statistics and the drift-noise factors.
   const ConsistencyStatus& consistency() const { return monitor_.status(); }
+  /// Empties the consistency monitor's window (ConsistencyMonitor::forgetEvidence).
+  void forgetConsistencyEvidence() { monitor_.forgetEvidence(); }
 
   const FilterConfig& config() const { return config_; }
   const StereoIntrinsics& intrinsics() const { return intrinsics_; }

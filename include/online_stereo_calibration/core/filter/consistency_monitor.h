@@ -155,6 +155,9 @@ class ConsistencyMonitor {
   /// Forgets the window's evidence and holds the action for consistency_startup_s (a
   /// re-opened block); the factors are kept.
   void clearWindow();
+  /// Forgets the window's evidence only: the hold and the factors are kept (the data
+  /// resume after a stretch without points; what came before says nothing of what follows).
+  void forgetEvidence();
   /// Advances the clock by dt (s) with one update's scores (none: a step without update)
   /// and updates the inflation factors.
   void addUpdate(double dt, const UpdateScores* scores);
