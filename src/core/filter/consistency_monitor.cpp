@@ -25,8 +25,23 @@ double normalUpperQuantile(double probability) {
   return 0.5 * (lo + hi);
 }
 
-/// g_S^T F_SS^+ g_S over the index set S, and the rank of F_SS: directions the update
-/// carries (relatively) no information on are left out, with their degrees of freedom.
+/// A symmetric PSD F scaled to unit diagonal, D F D with D = diag(1 / sqrt(F_aa)) (0 where
+/// F_aa <= 0): the blocks mix metres and radians. Its eigenvalues at or below 1e-9 of the
+/// largest count as zero: directions the update carries (relatively) no information on.
+struct ScaledEigen {
+  explicit ScaledEigen(const Eigen::MatrixXd& F) : scale(F.diagonal().cwiseMax(0.0).cwiseSqrt()) {
+    for (int a = 0; a < scale.size(); ++a) scale(a) = scale(a) > 0.0 ? 1.0 / scale(a) : 0.0;
+    eigen.compute(scale.asDiagonal() * F * scale.asDiagonal());
+    largest = eigen.eigenvalues().maxCoeff();
+  }
+  bool informative(int k) const { return largest > 0.0 && eigen.eigenvalues()(k) > 1e-9 * largest; }
+
+  Eigen::VectorXd scale;  ///< D's diagonal
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen;
+  double largest = 0.0;
+};
+
+/// g_S^T F_SS^+ g_S over the index set S, and the rank of F_SS (ScaledEigen's tolerance).
 double quadraticForm(const Eigen::MatrixXd& F, const Eigen::VectorXd& g,
                      const std::vector<int>& indices, int* rank) {
   const int n = static_cast<int>(indices.size());
@@ -36,21 +51,14 @@ double quadraticForm(const Eigen::MatrixXd& F, const Eigen::VectorXd& g,
     g_s(a) = g(indices[a]);
     for (int b = 0; b < n; ++b) F_s(a, b) = F(indices[a], indices[b]);
   }
-  // Scale to unit diagonal first: the blocks mix metres and radians.
-  Eigen::VectorXd scale = F_s.diagonal().cwiseMax(0.0).cwiseSqrt();
-  for (int a = 0; a < n; ++a) scale(a) = scale(a) > 0.0 ? 1.0 / scale(a) : 0.0;
-  F_s = scale.asDiagonal() * F_s * scale.asDiagonal();
-  g_s = scale.asDiagonal() * g_s;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(F_s);
-  const double largest = eigen.eigenvalues().maxCoeff();
+  const ScaledEigen scaled(F_s);
+  g_s = scaled.scale.asDiagonal() * g_s;
   double value = 0.0;
   *rank = 0;
-  if (!(largest > 0.0)) return 0.0;
   for (int k = 0; k < n; ++k) {
-    const double lambda = eigen.eigenvalues()(k);
-    if (lambda <= 1e-9 * largest) continue;
-    const double projection = eigen.eigenvectors().col(k).dot(g_s);
-    value += projection * projection / lambda;
+    if (!scaled.informative(k)) continue;
+    const double projection = scaled.eigen.eigenvectors().col(k).dot(g_s);
+    value += projection * projection / scaled.eigen.eigenvalues()(k);
     ++*rank;
   }
   return value;
@@ -62,22 +70,17 @@ std::vector<int> indexRange(int first, int count) {
   return r;
 }
 
-/// The pseudo-inverse of a symmetric PSD F with quadraticForm's scaling and rank tolerance.
+/// The pseudo-inverse of a symmetric PSD F with ScaledEigen's scaling and rank tolerance.
 Eigen::MatrixXd pseudoInverse(const Eigen::MatrixXd& F) {
+  const ScaledEigen scaled(F);
   const int n = static_cast<int>(F.rows());
-  Eigen::VectorXd scale = F.diagonal().cwiseMax(0.0).cwiseSqrt();
-  for (int a = 0; a < n; ++a) scale(a) = scale(a) > 0.0 ? 1.0 / scale(a) : 0.0;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scale.asDiagonal() * F *
-                                                             scale.asDiagonal());
-  const double largest = eigen.eigenvalues().maxCoeff();
   Eigen::VectorXd inverse = Eigen::VectorXd::Zero(n);
   for (int k = 0; k < n; ++k) {
-    const double lambda = eigen.eigenvalues()(k);
-    if (largest > 0.0 && lambda > 1e-9 * largest) inverse(k) = 1.0 / lambda;
+    if (scaled.informative(k)) inverse(k) = 1.0 / scaled.eigen.eigenvalues()(k);
   }
-  return scale.asDiagonal() *
-         (eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose()) *
-         scale.asDiagonal();
+  const Eigen::MatrixXd& V = scaled.eigen.eigenvectors();
+  return scaled.scale.asDiagonal() * (V * inverse.asDiagonal() * V.transpose()) *
+         scaled.scale.asDiagonal();
 }
 
 }  // namespace
