@@ -837,6 +837,10 @@ TEST(Campaign, AYawStepOfTheLeftCameraInABlindStretchIsReopenedWhenThePointsRetu
   // run is the same as with the test off.
   const CampaignRunSpec still = shippedRun(9, "kind: {none: 1}", 200);
   ASSERT_TRUE(still.error.empty()) << still.error;
+  ASSERT_EQ(settingOf(still.settings, "event"), "none");
+  // The blind stretch is still drawn, long enough for the check to follow it.
+  ASSERT_GT(std::stod(settingOf(still.settings, "blind_s")),
+            EstimatorConfig().filter.unobserved_gap);
   const CampaignRow still_shipped = runShipped(still);
   const CampaignRow still_without =
       runShipped(still, [](FilterConfig* c) { c->unobserved_gap = 0.0; });
