@@ -40,6 +40,21 @@ TEST(FilterConfigYaml, ShippedFilesAreUpToDateWithTheCode) {
                    paperFilterConfig());
 }
 
+// Bit for bit, not within a tolerance: a run with --config config/default.yaml must equal one
+// without (a _deg key printed with 12 digits read back 2.99999999999569 rad/s for 3).
+TEST(FilterConfigYaml, ShippedDefaultFileReadsBackToTheBuiltInDefaultsExactly) {
+  const FilterConfig defaults;
+  const FilterConfig read =
+      readFilterConfigFile(std::string(OSC_SOURCE_DIR) + "/config/default.yaml");
+  for (const ParameterSpec& spec : filterParameterTable()) {
+    if (spec.real_field) {
+      EXPECT_EQ(read.*spec.real_field, defaults.*spec.real_field) << spec.name;
+    } else {
+      EXPECT_EQ(read.*spec.integer_field, defaults.*spec.integer_field) << spec.name;
+    }
+  }
+}
+
 TEST(FilterConfigYaml, PaperFileHoldsThePapersNumbers) {
   const std::string text = readText(std::string(OSC_SOURCE_DIR) + "/config/paper.yaml");
   EXPECT_NE(text.find("point_position_noise_m: 0.2\n"), std::string::npos);      // eq. 14

@@ -76,6 +76,29 @@ FilterConfig readFilterConfigFile(const std::string& path, const FilterConfig& b
   return parseFilterConfigYaml(text.str(), path, base);
 }
 
+namespace {
+
+/// @p spec's value in file units with the fewest significant digits (12 to 17) that read
+/// back to the identical internal value: a `_deg` key's internal radians survive the trip
+/// through degrees, so a run with the written file equals one with the built-in config.
+std::string formatFileValue(const ParameterSpec& spec, const FilterConfig& config) {
+  const double value = spec.get(config);
+  std::string text;
+  for (int digits = 12; digits <= 17; ++digits) {
+    std::ostringstream out;
+    out << std::setprecision(digits) << value;
+    text = out.str();
+    FilterConfig read_back = config;
+    spec.set(&read_back, std::stod(text));
+    const bool same = spec.real_field ? read_back.*spec.real_field == config.*spec.real_field
+                                      : read_back.*spec.integer_field == config.*spec.integer_field;
+    if (same) break;
+  }
+  return text;
+}
+
+}  // namespace
+
 std::string formatFilterConfigYaml(const FilterConfig& config, const std::string& title) {
   std::ostringstream out;
   out << "# " << title << "\n"
@@ -85,8 +108,9 @@ std::string formatFilterConfigYaml(const FilterConfig& config, const std::string
       << "# shared: one 6-DoF motion error per step shared by all points (ours).\n"
       << "motion_noise_model: " << motionNoiseModelName(config.motion_noise_model) << "\n";
   for (const ParameterSpec& spec : filterParameterTable()) {
-    out << "\n# " << spec.doc << " [" << spec.min_value << ", " << spec.max_value << "]\n"
-        << spec.name << ": " << std::setprecision(12) << spec.get(config) << "\n";
+    out << "\n# " << spec.doc << " [" << std::setprecision(12) << spec.min_value << ", "
+        << spec.max_value << "]\n"
+        << spec.name << ": " << formatFileValue(spec, config) << "\n";
   }
   return out.str();
 }
