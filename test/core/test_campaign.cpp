@@ -287,6 +287,9 @@ TEST(CampaignScore, CountsFramesAgainstTheSigmasFromFrame30) {
   EXPECT_EQ(s.max_z_parameter, "pitch_r");
   EXPECT_DOUBLE_EQ(s.nees_mean, 2.0);
   EXPECT_EQ(s.converged_frame, 45);
+  // Frames 45-99 are CONVERGED; of them 50 and 60 are beyond 3 sigma (40 is not converged).
+  EXPECT_EQ(s.frames_converged, 55);
+  EXPECT_EQ(s.frames_converged_beyond_3sigma, 2);
   EXPECT_DOUBLE_EQ(s.time_ms_median, 50.0);
   // All 100 frames are within the last 150: xl has error 1 in frames 0-29, 0.01 after.
   EXPECT_NEAR(s.rmse[0], std::sqrt((30 * 1.0 + 70 * 1e-4) / 100), 1e-12);
@@ -359,6 +362,8 @@ TEST(CampaignCsv, RowsRoundTripAndFailedRowsKeepTheirColumns) {
   row.score.first_frame_beyond_5sigma = 44;
   row.score.nees_mean = 1.5;
   row.score.converged_frame = -1;
+  row.score.frames_converged = 9;
+  row.score.frames_converged_beyond_3sigma = 7;
   row.score.time_ms_median = 0.75;
   for (int p = 0; p < 12; ++p) row.score.rmse[p] = 0.001 * (p + 1);
   row.settings = drawCampaignRun(ranges, 4, 11, 100, false).settings;
@@ -375,6 +380,8 @@ TEST(CampaignCsv, RowsRoundTripAndFailedRowsKeepTheirColumns) {
   EXPECT_EQ(back[0].score.frames_beyond_5sigma_unseen, 2);
   EXPECT_EQ(back[0].score.max_z_parameter, "yaw_r");
   EXPECT_EQ(back[0].score.first_frame_beyond_5sigma, 44);
+  EXPECT_EQ(back[0].score.frames_converged, 9);
+  EXPECT_EQ(back[0].score.frames_converged_beyond_3sigma, 7);
   EXPECT_EQ(back[0].score.rmse[11], 0.012);
   EXPECT_EQ(back[0].settings, row.settings);
   EXPECT_TRUE(back[0].ok());
@@ -398,6 +405,8 @@ TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
     row.score.max_z = static_cast<double>(i);
     if (i == 2 || i == 3) row.score.frames_beyond_5sigma = 10;  // run 3: 4 of them unseen
     if (i == 3) row.score.frames_beyond_5sigma_unseen = 4;
+    row.score.frames_converged = 50;                            // 250 in all
+    row.score.frames_converged_beyond_3sigma = i == 1 ? 5 : 0;  // 5 of 250 in run 1
     rows.push_back(row);
   }
   const std::vector<CampaignBucket> x = campaignBuckets(rows, "x");
@@ -419,6 +428,10 @@ TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
       << summary;
   EXPECT_NE(summary.find("Frames beyond 5 sigma: 20 in 2 runs; of them 4 in 1 runs in an unseen "
                          "change"),
+            std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("250 frames CONVERGED, of them 5 (2.0 %) in 1 runs with some error "
+                         "beyond 3 sigma"),
             std::string::npos)
       << summary;
   // The worst run listed first is the one that is not honest with the largest max_z, though
@@ -877,6 +890,8 @@ TEST(Campaign, FourRunsOf100FramesWriteTheDocumentedColumnsAndResume) {
                                        "first_frame_beyond_5sigma",
                                        "nees_mean",
                                        "converged_frame",
+                                       "frames_converged",
+                                       "frames_converged_beyond_3sigma",
                                        "time_ms_median"};
   for (const char* p : {"xl", "yl", "zl", "roll_l", "pitch_l", "yaw_l", "xr", "yr", "zr", "roll_r",
                         "pitch_r", "yaw_r"}) {

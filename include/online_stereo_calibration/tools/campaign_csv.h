@@ -1,7 +1,8 @@
 /// @file campaign_csv.h
 /// @brief The rows of DIR/campaign.csv (and of DIR/runs/run_NNNN.csv, one row each):
 /// `run,seed,frames,share_within_3sigma,frames_beyond_5sigma,max_z,max_z_parameter,
-/// first_frame_beyond_5sigma,nees_mean,converged_frame,time_ms_median`, then `rmse_<p>` for
+/// first_frame_beyond_5sigma,nees_mean,converged_frame,frames_converged,
+/// frames_converged_beyond_3sigma,time_ms_median`, then `rmse_<p>` for
 /// the 12 parameters (m, rad), then the drawn settings (campaignSettingNames()), then
 /// `run_s` (wall time of the run, s) and `status` ("ok" or "failed: why"; a failed run has
 /// nan scores).

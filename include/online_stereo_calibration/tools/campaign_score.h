@@ -42,6 +42,12 @@ struct CampaignScore {
   double nees_mean = 0.0;
   /// First frame at which the state is CONVERGED (isConverged); -1 if never.
   int converged_frame = -1;
+  /// Frames (from frame 0) in the CONVERGED state: what a user who trusts the state sees.
+  int frames_converged = 0;
+  /// Of those, the frames with some |error| > 3 sigma: the state says "trust me" while the
+  /// estimate is off. An honest 12-parameter Gaussian filter shows about 3 % of its frames
+  /// so (1 - 0.9973^12); far more means CONVERGED is confidently wrong.
+  int frames_converged_beyond_3sigma = 0;
   /// Median estimator time per frame (ms).
   double time_ms_median = 0.0;
   /// RMSE of each parameter over the last kCampaignRmseFrames frames (m, rad).

@@ -27,6 +27,8 @@ const std::vector<std::string>& scoreColumns() {
                                                    "first_frame_beyond_5sigma",
                                                    "nees_mean",
                                                    "converged_frame",
+                                                   "frames_converged",
+                                                   "frames_converged_beyond_3sigma",
                                                    "time_ms_median"};
   return columns;
 }
@@ -70,6 +72,7 @@ CampaignRow failedCampaignRow(int run, unsigned seed, int frames, const Campaign
   row.score.share_within_3sigma = row.score.max_z = row.score.nees_mean = nan;
   row.score.time_ms_median = nan;
   row.score.frames_beyond_5sigma = row.score.frames_beyond_5sigma_unseen = -1;
+  row.score.frames_converged = row.score.frames_converged_beyond_3sigma = -1;
   row.score.max_z_parameter = "-";
   row.score.rmse.fill(nan);
   row.settings = settings;
@@ -101,7 +104,8 @@ std::string formatCampaignCsvLine(const CampaignRow& row,
   line << row.run << ',' << row.seed << ',' << row.frames << ',' << number(s.share_within_3sigma)
        << ',' << s.frames_beyond_5sigma << ',' << s.frames_beyond_5sigma_unseen << ','
        << number(s.max_z) << ',' << s.max_z_parameter << ',' << s.first_frame_beyond_5sigma << ','
-       << number(s.nees_mean) << ',' << s.converged_frame << ',' << number(s.time_ms_median);
+       << number(s.nees_mean) << ',' << s.converged_frame << ',' << s.frames_converged << ','
+       << s.frames_converged_beyond_3sigma << ',' << number(s.time_ms_median);
   for (double r : s.rmse) line << ',' << number(r);
   for (size_t i = 0; i < setting_names.size(); ++i) {
     line << ',';
@@ -173,6 +177,8 @@ std::vector<CampaignRow> parseCampaignCsv(const std::string& text, const std::st
     row.score.first_frame_beyond_5sigma = static_cast<int>(integer(column++));
     row.score.nees_mean = real(column++);
     row.score.converged_frame = static_cast<int>(integer(column++));
+    row.score.frames_converged = static_cast<int>(integer(column++));
+    row.score.frames_converged_beyond_3sigma = static_cast<int>(integer(column++));
     row.score.time_ms_median = real(column++);
     for (int p = 0; p < 12; ++p) row.score.rmse[p] = real(column++);
     for (; column + 2 < f.size(); ++column) row.settings.emplace_back(header[column], f[column]);

@@ -69,7 +69,9 @@ CampaignRow replayCampaignRun(const CampaignInputs& inputs, const std::string& o
        << row.score.frames_beyond_5sigma << ", max_z " << row.score.max_z << " ("
        << row.score.max_z_parameter << "), first_frame_beyond_5sigma "
        << row.score.first_frame_beyond_5sigma << ", nees_mean " << row.score.nees_mean
-       << ", converged_frame " << row.score.converged_frame << "\n\ndrawn settings:\n";
+       << ", converged_frame " << row.score.converged_frame << ", frames_converged "
+       << row.score.frames_converged << " (beyond 3 sigma "
+       << row.score.frames_converged_beyond_3sigma << ")\n\ndrawn settings:\n";
   for (const auto& [name, value] : spec.settings) text << "  " << name << " = " << value << "\n";
   if (report) *report << text.str();
   writeTextFileAtomic(dir + "/settings.txt", text.str());

@@ -16,6 +16,21 @@ double wrapAngle(double a) {
 
 bool isAngle(int index) { return index % 6 >= 3; }
 
+/// |estimate - truth| / sigma per parameter; a NaN estimate or sigma is +inf.
+std::array<double, 12> errorsInSigmas(const ScenarioFrameResult& f) {
+  std::array<double, 12> z{};
+  for (int p = 0; p < 12; ++p) {
+    double e = f.parameters(p) - f.truth(p);
+    if (isAngle(p)) e = wrapAngle(e);
+    z[p] = std::abs(e) / f.sigmas(p);
+    if (std::abs(e) == 0.0) z[p] = 0.0;
+    if (!std::isfinite(e) || !(f.sigmas(p) >= 0.0) || std::isnan(z[p])) {
+      z[p] = std::numeric_limits<double>::infinity();
+    }
+  }
+  return z;
+}
+
 }  // namespace
 
 const std::array<std::string, 12>& campaignParameterNames() {
@@ -35,30 +50,30 @@ std::vector<FrameSpan> unseenChangeSpans(const MeasurementScenario& scenario) {
 CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames,
                                const std::vector<FrameSpan>& unseen) {
   CampaignScore score;
-  const double inf = std::numeric_limits<double>::infinity();
   int scored = 0, within = 0;
   double nees_sum = 0.0;
   int max_index = 0;
   for (const ScenarioFrameResult& f : frames) {
-    if (f.converged && score.converged_frame < 0) score.converged_frame = f.frame;
+    const std::array<double, 12> z = errorsInSigmas(f);
+    const auto someBeyond = [&z](double bound) {
+      return std::any_of(z.begin(), z.end(), [bound](double v) { return !(v <= bound); });
+    };
+    const bool some_beyond_3 = someBeyond(3.0);
+    if (f.converged) {
+      if (score.converged_frame < 0) score.converged_frame = f.frame;
+      ++score.frames_converged;
+      score.frames_converged_beyond_3sigma += some_beyond_3;
+    }
     if (f.frame < kCampaignFirstScoredFrame) continue;
     ++scored;
-    bool all_within = true, some_beyond = false;
     for (int p = 0; p < 12; ++p) {
-      double e = f.parameters(p) - f.truth(p);
-      if (isAngle(p)) e = wrapAngle(e);
-      double z = std::abs(e) / f.sigmas(p);
-      if (std::abs(e) == 0.0) z = 0.0;
-      if (!std::isfinite(e) || !(f.sigmas(p) >= 0.0) || std::isnan(z)) z = inf;
-      if (!(z <= 3.0)) all_within = false;
-      if (!(z <= 5.0)) some_beyond = true;
-      if (z > score.max_z) {
-        score.max_z = z;
+      if (z[p] > score.max_z) {
+        score.max_z = z[p];
         max_index = p;
       }
     }
-    within += all_within;
-    if (some_beyond) {
+    within += !some_beyond_3;
+    if (someBeyond(5.0)) {
       ++score.frames_beyond_5sigma;
       score.frames_beyond_5sigma_unseen += inFrameSpans(unseen, f.frame);
       if (score.first_frame_beyond_5sigma < 0) score.first_frame_beyond_5sigma = f.frame;

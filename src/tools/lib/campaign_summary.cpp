@@ -103,6 +103,7 @@ std::string formatCampaignSummary(const std::vector<CampaignRow>& rows, int wors
   std::ostringstream text;
   int ok = 0, honest = 0;
   int runs_beyond = 0, frames_beyond = 0, runs_unseen = 0, frames_unseen = 0;
+  int frames_converged = 0, frames_converged_off = 0, runs_converged_off = 0;
   std::vector<double> shares, max_z, nees, times, converged;
   for (const CampaignRow& row : rows) {
     ok += row.ok();
@@ -117,6 +118,9 @@ std::string formatCampaignSummary(const std::vector<CampaignRow>& rows, int wors
     nees.push_back(row.score.nees_mean);
     times.push_back(row.score.time_ms_median);
     if (row.score.converged_frame >= 0) converged.push_back(row.score.converged_frame);
+    frames_converged += row.score.frames_converged;
+    frames_converged_off += row.score.frames_converged_beyond_3sigma;
+    runs_converged_off += row.score.frames_converged_beyond_3sigma > 0;
   }
   const int n = static_cast<int>(rows.size());
   text << "Campaign of " << n << " runs (" << ok << " ran, " << n - ok << " failed)\n"
@@ -132,7 +136,13 @@ std::string formatCampaignSummary(const std::vector<CampaignRow>& rows, int wors
        << format("%.2f", median(nees)) << ", time per frame " << format("%.2f", median(times))
        << " ms\n"
        << "Converged (CONVERGED state reached): " << converged.size() << " of " << ok
-       << " runs, median at frame " << format("%.0f", median(converged)) << "\n\n";
+       << " runs, median at frame " << format("%.0f", median(converged)) << "; " << frames_converged
+       << " frames CONVERGED, of them " << frames_converged_off << " ("
+       << (frames_converged == 0
+               ? "-"
+               : format("%.1f %%", 100.0 * frames_converged_off / frames_converged))
+       << ") in " << runs_converged_off
+       << " runs with some error beyond 3 sigma (about 3 % when honest)\n\n";
 
   std::vector<int> order(rows.size());
   for (int i = 0; i < n; ++i) order[i] = i;
