@@ -191,7 +191,8 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "0 = off)"),
       real("odometry_velocity_bias_sigma_mps", &C::odometry_velocity_bias_sigma, 1.0, 0.0, 10.0,
            "steady-state 1 sigma of a slowly varying odometry velocity error, estimated per "
-           "lateral and vertical vehicle axis (0 = not estimated)"),
+           "lateral and vertical vehicle axis (0 = not estimated); no smaller than your "
+           "odometry's: a larger error is taken for a tilted camera"),
       real("odometry_forward_velocity_bias_sigma_mps", &C::odometry_forward_velocity_bias_sigma,
            1.0, 0.0, 10.0,
            "the same for the forward vehicle axis (a scale error on a car, not on a drone; 0 = "
@@ -204,7 +205,8 @@ const std::vector<ParameterSpec>& filterParameterTable() {
       real("camr_rotation_drift_rate_sigma_deg_per_min", &C::camr_rotation_drift_rate_sigma,
            kDeg / 60.0, 0.0, 1e4,
            "steady-state 1 sigma per axis of the rate at which x_camr's rotation drifts, "
-           "estimated as a state (0 = not estimated)"),
+           "estimated as a state (0 = not estimated); a drift several times faster is "
+           "followed with a lag"),
       real("camr_drift_rate_correlation_time_s", &C::camr_drift_rate_correlation_time, 1.0, 0.1,
            1e6, "correlation time of that drift rate (first-order Gauss-Markov)"),
       real("consistency_window_s", &C::consistency_window, 1.0, 0.0, 1e4,

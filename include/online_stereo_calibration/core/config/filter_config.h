@@ -257,7 +257,11 @@ struct FilterConfig {
   /// campaign: 33 -> 74 of 200 runs honest, docs/RESULTS.md "Odometry errors"). The price:
   /// pitch_l and yaw_l are only as certain as the odometry's direction (paper_offroad:
   /// pitch_l 0.030 -> 0.067 deg RMSE, still a tenth of Table I). 0 for odometry known to
-  /// have no such error.
+  /// have no such error; set it to your odometry's if that is larger. 0.02 (session 30):
+  /// default campaign runs whose odometry has a 15-20 mm/s error 42 -> 48 of 59 honest
+  /// (164 -> 172 of 200), but paper_offroad (white-noise odometry) yl and yaw_l +32 %,
+  /// runs reaching CONVERGED 91 -> 70 and a start-troubled run 25 -> 127 frames beyond
+  /// 5 sigma; lateral or vertical alone does not help (docs/RESULTS.md "Session 30").
   double odometry_velocity_bias_sigma = 0.01;
   /// The same for the forward (vehicle x) axis. On a car at a steady speed a forward error
   /// is a scale error, which images cannot tell (odometry_scale_sigma); on a slow platform
@@ -290,7 +294,10 @@ struct FilterConfig {
   /// estimation error: paper_offroad yaw_r 0.0018 -> 0.0022 deg RMSE pooled. At 0.1
   /// deg/min the rate took yaw_r's slow start-up convergence on a drone for a drift (run 40
   /// without its event: 78 % of the frames within 3 sigma) (docs/RESULTS.md "Session 13").
-  /// 0 = not estimated (the paper).
+  /// 0 = not estimated (the paper). At 0.1 and 0.2 deg/min (session 30) the drift runs get
+  /// better (default campaign 38 -> 41 / 42 of 48, drift-only 32 -> 34 of 40, none beyond
+  /// 5 sigma) and two other runs go beyond 5 sigma (56: yl, 144: pitch_l; 52 -> 174 frames of
+  /// the filter's own), at 0.2 also 126 -> 118 of the 152 others honest.
   double camr_rotation_drift_rate_sigma = 0.05 / 60.0 * 0.0174532925199432958;  ///< rad/s
   /// s, correlation time of that rate: a thermal drift keeps its direction for long (at
   /// 300 s and 0.1 deg/min paper_offroad's yaw_r RMSE was 0.0024 deg, 0.0023 at 3000 s).
