@@ -479,6 +479,39 @@ std::string scoreText(const CampaignRow& row) {
   return text.str();
 }
 
+// Issue 14: "an honest and reachable state": a user who trusts CONVERGED must find the errors
+// within the sigmas. An honest Gaussian filter has about 3 % of its frames with some of the
+// 12 errors beyond 3 sigma whatever its state says (12 x 0.27 %). The shipped filter over the
+// first ten runs of the shipped ranges, against one that declares the odometry's motion noise
+// 5x smaller than the simulator's: its sigmas shrink to CONVERGED as fast, its errors do not.
+// (A pixel noise declared 3x or 10x too small never reaches CONVERGED on these runs: its
+// innovations keep re-opening the blocks. Without the velocity-error states: 590 of 1172
+// CONVERGED frames beyond 3 sigma.)
+TEST(Campaign, TheConvergedStateIsReachedAndNotConfidentlyWrong) {
+  int converged = 0, converged_off = 0, overconfident_converged = 0, overconfident_off = 0;
+  for (int run = 0; run < 10; ++run) {
+    const CampaignRunSpec spec = shippedRun(run);
+    ASSERT_TRUE(spec.error.empty()) << spec.error;
+    const CampaignRow shipped = runShipped(spec);
+    const CampaignRow overconfident = runShipped(spec, [](FilterConfig* c) {
+      c->motion_translation_noise /= 5.0;
+      c->motion_rotation_noise /= 5.0;
+    });
+    ASSERT_TRUE(shipped.ok()) << shipped.status;
+    ASSERT_TRUE(overconfident.ok()) << overconfident.status;
+    converged += shipped.score.frames_converged;
+    converged_off += shipped.score.frames_converged_beyond_3sigma;
+    overconfident_converged += overconfident.score.frames_converged;
+    overconfident_off += overconfident.score.frames_converged_beyond_3sigma;
+  }
+  // Measured: 1071 frames CONVERGED in 5 of the 10 runs, 2 of them beyond 3 sigma.
+  EXPECT_GE(converged, 500);
+  EXPECT_LE(converged_off, 0.03 * converged) << converged_off << " of " << converged;
+  // Measured: 1582 of 1864 frames CONVERGED beyond 3 sigma.
+  EXPECT_GT(overconfident_off, 0.3 * overconfident_converged)
+      << overconfident_off << " of " << overconfident_converged;
+}
+
 TEST(Campaign, AYawStepOfTheLeftCameraOnAFlatRoadIsDetectedThoughZlStaysOpen) {
   // Run 121 of the shipped ranges (config/campaign.yaml, seed 122): a sideways-left camera on
   // an urban (planar) drive, x_caml yawed by -4.8 deg at frame 301. zl cannot be determined on
