@@ -16,12 +16,17 @@ double wrapAngle(double a) {
 
 bool isAngle(int index) { return index % 6 >= 3; }
 
+/// Estimate - truth of parameter @p p (angles wrapped).
+double parameterError(const ScenarioFrameResult& f, int p) {
+  const double e = f.parameters(p) - f.truth(p);
+  return isAngle(p) ? wrapAngle(e) : e;
+}
+
 /// |estimate - truth| / sigma per parameter; a NaN estimate or sigma is +inf.
 std::array<double, 12> errorsInSigmas(const ScenarioFrameResult& f) {
   std::array<double, 12> z{};
   for (int p = 0; p < 12; ++p) {
-    double e = f.parameters(p) - f.truth(p);
-    if (isAngle(p)) e = wrapAngle(e);
+    const double e = parameterError(f, p);
     z[p] = std::abs(e) / f.sigmas(p);
     if (std::abs(e) == 0.0) z[p] = 0.0;
     if (!std::isfinite(e) || !(f.sigmas(p) >= 0.0) || std::isnan(z[p])) {
@@ -98,8 +103,7 @@ CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames,
   for (int p = 0; p < 12; ++p) {
     double sum = 0.0;
     for (size_t i = first; i < frames.size(); ++i) {
-      double e = frames[i].parameters(p) - frames[i].truth(p);
-      if (isAngle(p)) e = wrapAngle(e);
+      const double e = parameterError(frames[i], p);
       sum += e * e;
     }
     score.rmse[p] = std::sqrt(sum / (frames.size() - first));
