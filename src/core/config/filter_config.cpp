@@ -119,6 +119,10 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "rotation 1 sigma re-opened after a detected jump"),
       real("jump_translation_sigma_m", &C::jump_translation_sigma, 1.0, 0.0, 10.0,
            "translation 1 sigma re-opened after a detected jump"),
+      real("jump_fit_rotation_sigma_deg", &C::jump_fit_rotation_sigma, kDeg, 0.0, 90.0,
+           "x_caml after a jump seen by most tracked points at once: its rotation is fitted "
+           "to their left bearings and each axis re-opened to max(this, what it turned) "
+           "instead of jump_rotation_sigma_deg (0 = off: every axis to that)"),
       real("jump_settle_time_s", &C::jump_settle_time, 1.0, 0.0, 1e6,
            "time after a block's start or re-opening from which its rotation alone decides "
            "whether a jump can re-open it (a translation the motion cannot tell stays wide)"),

@@ -62,23 +62,20 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
       baseline_from_motion_(baselineConfig(config, left_)) {
   filter_.reset(initial_guess);
   guess_covariance_ = filter_.covariance();
-  anchorHere(JumpBlock::kNone, 0.0, 0.0);
+  anchorHere(JumpBlock::kNone, Vector6d::Zero());
 }
 
-void StereoCalibrationEstimator::anchorHere(JumpBlock block, double translation_sigma,
-                                            double rotation_sigma) {
+void StereoCalibrationEstimator::anchorHere(JumpBlock block, const Vector6d& reopened_sigma) {
   anchor_ = LinearizationAnchor();
   anchor_.extrinsics = filter_.extrinsics();
   anchor_.covariance = filter_.covariance();
   anchor_.blocks = {{block != JumpBlock::kLeftToRight, block != JumpBlock::kVehicleToLeft}};
-  anchor_.translation_sigma = translation_sigma;
-  anchor_.rotation_sigma = rotation_sigma;
+  anchor_.reopened_sigma = reopened_sigma;
 }
 
-void StereoCalibrationEstimator::anchorReopening(JumpBlock block, double translation_sigma,
-                                                 double rotation_sigma) {
+void StereoCalibrationEstimator::anchorReopening(JumpBlock block, const Vector6d& reopened_sigma) {
   const bool start_is_live = anchorIsLive() && anchor_.blocks[0] && anchor_.blocks[1];
-  if (!start_is_live) anchorHere(block, translation_sigma, rotation_sigma);
+  if (!start_is_live) anchorHere(block, reopened_sigma);
 }
 
 double StereoCalibrationEstimator::movedSinceAnchor(int block) const {
@@ -93,8 +90,7 @@ double StereoCalibrationEstimator::movedSinceAnchor(int block) const {
   double largest = 0.0;
   for (int k = 0; k < 6; ++k) {
     const double variance = anchor_.covariance(6 * block + k, 6 * block + k);
-    const double reopened = k < 3 ? anchor_.translation_sigma : anchor_.rotation_sigma;
-    if (!(variance > 0.0) || (!whole_start && !(reopened > 0.0))) continue;
+    if (!(variance > 0.0) || (!whole_start && !(anchor_.reopened_sigma(k) > 0.0))) continue;
     largest = std::max(largest, std::abs(moved(k)) / std::sqrt(variance));
   }
   return largest;
@@ -147,14 +143,13 @@ bool StereoCalibrationEstimator::relinearizeIfMoved(FrameReport* report) {
   } else {
     for (int block = 0; block < 2; ++block) {
       if (!restart[static_cast<size_t>(block)]) continue;
-      double translation_sigma = anchor_.translation_sigma, rotation_sigma = anchor_.rotation_sigma;
+      Vector6d sigma = anchor_.reopened_sigma;
       if (whole_start) {  // the start's own sigmas of this block
         const Vector6d variance = anchor_.covariance.diagonal().segment<6>(6 * block);
-        translation_sigma = std::sqrt(variance.head<3>().maxCoeff());
-        rotation_sigma = std::sqrt(variance.tail<3>().maxCoeff());
+        sigma = uniformBlockSigmas(std::sqrt(variance.head<3>().maxCoeff()),
+                                   std::sqrt(variance.tail<3>().maxCoeff()));
       }
-      filter_.reopen(block == 0 ? JumpBlock::kVehicleToLeft : JumpBlock::kLeftToRight,
-                     translation_sigma, rotation_sigma);
+      filter_.reopen(block == 0 ? JumpBlock::kVehicleToLeft : JumpBlock::kLeftToRight, sigma);
     }
   }
   anchor_.extrinsics = filter_.extrinsics();
@@ -206,7 +201,8 @@ bool StereoCalibrationEstimator::restartFromMotion(
       Eigen::Matrix3d::Identity() * translation_sigma * translation_sigma;
   covariance.template block<3, 3>(kCaml + kRotation, kCaml + kRotation) = restart.covariance;
   filter_.reset(start, covariance);
-  anchorHere(JumpBlock::kNone, 0.0, 0.0);  // a start: both blocks re-linearised as after one
+  anchorHere(JumpBlock::kNone,
+             Vector6d::Zero());  // a start: both blocks re-linearised as after one
   report->mounting_rotation_from_motion = true;
   const Eigen::Vector3d before = rpyFromRotation(now.T_veh_caml.linear()) * 180.0 / M_PI;
   const Eigen::Vector3d after = rpyFromRotation(restart.R_veh_caml) * 180.0 / M_PI;
@@ -329,8 +325,11 @@ FrameReport StereoCalibrationEstimator::processFrame(
       if (report.step.jump != JumpBlock::kNone) {
         report.warnings.push_back(report.step.message);
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());
-        anchorReopening(report.step.jump, config_.jump_translation_sigma,
-                        config_.jump_rotation_sigma);
+        anchorReopening(report.step.jump, report.step.jump_sigma);
+        // x_caml was re-opened on its own evidence: the check after a stretch without points
+        // has its answer (left armed, it could re-open the axes a fitted turn kept to
+        // jump_rotation_sigma_deg on the next frames' transient).
+        if (report.step.jump == JumpBlock::kVehicleToLeft) gap_check_left_ = 0.0;
       } else if (reopenLeftCameraAfterGap(motion, &report)) {
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());
       } else if (relinearizeIfMoved(&report)) {
@@ -538,11 +537,11 @@ bool StereoCalibrationEstimator::reopenLeftCameraAfterGap(const MotionIncrement&
   const int caml = static_cast<int>(ConsistencyBlock::kVehicleToLeft);
   if (!consistency.exceeded[caml] || consistency.window_updates < kLeastUpdates) return false;
   gap_check_left_ = 0.0;
-  const std::vector<PointId> dropped = filter_.reopen(
-      JumpBlock::kVehicleToLeft, config_.jump_translation_sigma, config_.jump_rotation_sigma);
+  const Vector6d sigma =
+      uniformBlockSigmas(config_.jump_translation_sigma, config_.jump_rotation_sigma);
+  const std::vector<PointId> dropped = filter_.reopen(JumpBlock::kVehicleToLeft, sigma);
   report->dropped.insert(report->dropped.end(), dropped.begin(), dropped.end());
-  anchorReopening(JumpBlock::kVehicleToLeft, config_.jump_translation_sigma,
-                  config_.jump_rotation_sigma);
+  anchorReopening(JumpBlock::kVehicleToLeft, sigma);
   report->left_camera_reopened_after_gap = true;
   std::ostringstream message;
   message << "x_caml re-opened: the updates after a stretch without points disagree with it "
@@ -564,8 +563,9 @@ std::vector<PointId> StereoCalibrationEstimator::resetTracking() {
 
 std::vector<PointId> StereoCalibrationEstimator::reopenRightCameraRotation(double rotation_sigma) {
   has_previous_frame_ = false;
-  std::vector<PointId> dropped = filter_.reopen(JumpBlock::kLeftToRight, 0.0, rotation_sigma);
-  anchorReopening(JumpBlock::kLeftToRight, 0.0, rotation_sigma);
+  const Vector6d sigma = uniformBlockSigmas(0.0, rotation_sigma);
+  std::vector<PointId> dropped = filter_.reopen(JumpBlock::kLeftToRight, sigma);
+  anchorReopening(JumpBlock::kLeftToRight, sigma);
   return dropped;
 }
 
@@ -603,10 +603,11 @@ std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
   has_previous_frame_ = false;
   mounting_.forgetFrame();
   if (start) {
-    anchorHere(JumpBlock::kNone, 0.0, 0.0);
+    anchorHere(JumpBlock::kNone, Vector6d::Zero());
   } else {
-    anchorReopening(JumpBlock::kLeftToRight, std::sqrt(covariance.diagonal().head<3>().maxCoeff()),
-                    std::sqrt(covariance.diagonal().tail<3>().maxCoeff()));
+    anchorReopening(JumpBlock::kLeftToRight,
+                    uniformBlockSigmas(std::sqrt(covariance.diagonal().head<3>().maxCoeff()),
+                                       std::sqrt(covariance.diagonal().tail<3>().maxCoeff())));
   }
   return dropped;
 }
@@ -626,7 +627,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
   filter_.reset(guess);
   guess_covariance_ = filter_.covariance();
   has_previous_frame_ = false;
-  anchorHere(JumpBlock::kNone, 0.0, 0.0);
+  anchorHere(JumpBlock::kNone, Vector6d::Zero());
 }
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
@@ -644,7 +645,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
                            : Matrix12d(0.5 * (internal + internal.transpose())));
   guess_covariance_ = filter_.covariance();
   has_previous_frame_ = false;
-  anchorHere(JumpBlock::kNone, 0.0, 0.0);
+  anchorHere(JumpBlock::kNone, Vector6d::Zero());
 }
 
 Matrix12d StereoCalibrationEstimator::odometryScaleCovariance(

@@ -179,8 +179,9 @@ class StereoCalibrationEstimator {
     Matrix12d covariance = Matrix12d::Identity();
     /// Blocks checked and restarted: both after a start, one after a re-opening.
     std::array<bool, 2> blocks{{true, true}};
-    /// The re-opened block's sigmas (m, rad), to widen it again on a restart.
-    double translation_sigma = 0.0, rotation_sigma = 0.0;
+    /// The re-opened block's sigmas [dt (3), dtheta (3)] (m, rad), to widen it again on a
+    /// restart; 0: that component was not re-opened (and is not checked).
+    Vector6d reopened_sigma = Vector6d::Zero();
     int frames = 0;    ///< accepted steps since the anchor or the last check
     int steps = 0;     ///< accepted steps since the start or re-opening (over restarts)
     int restarts = 0;  ///< restarts since the start or re-opening
@@ -193,13 +194,14 @@ class StereoCalibrationEstimator {
   /// What the odometry's scale uncertainty adds to the covariance of the translations at
   /// @p extrinsics (FilterConfig::odometry_scale_sigma; zero when 0).
   Matrix12d odometryScaleCovariance(const StereoExtrinsics& extrinsics) const;
-  /// Anchors at the filter's state now (after a start or re-opening of @p block).
-  void anchorHere(JumpBlock block, double translation_sigma, double rotation_sigma);
+  /// Anchors at the filter's state now (after a start, or a re-opening of @p block to
+  /// @p reopened_sigma, LinearizationAnchor::reopened_sigma).
+  void anchorHere(JumpBlock block, const Vector6d& reopened_sigma);
   /// anchorHere after a re-opening of @p block, unless a start's anchor is still live: a
   /// re-opening while a start is still being re-linearised is part of that start (a guess far
   /// off gates many points out, or moves the pairs off x_camr's epipolar band), and the
   /// start's anchor covers both blocks.
-  void anchorReopening(JumpBlock block, double translation_sigma, double rotation_sigma);
+  void anchorReopening(JumpBlock block, const Vector6d& reopened_sigma);
   /// Largest move since the anchor of a tangent component of @p block (0 x_caml, 1 x_camr)
   /// that the anchor checks (all after a start, the re-opened ones after a re-opening), in
   /// the anchor's 1 sigmas; 0 for a block the anchor does not check.

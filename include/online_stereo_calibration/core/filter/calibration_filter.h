@@ -64,6 +64,13 @@ struct PredictedObservation {
 /// Which calibration block a detected sudden change was attributed to.
 enum class JumpBlock { kNone, kVehicleToLeft, kLeftToRight };
 
+/// A block's re-opening sigmas [dt (3), dtheta (3)] with one width per kind.
+inline Vector6d uniformBlockSigmas(double translation_sigma, double rotation_sigma) {
+  Vector6d sigma;
+  sigma << Eigen::Vector3d::Constant(translation_sigma), Eigen::Vector3d::Constant(rotation_sigma);
+  return sigma;
+}
+
 /// What one filter step did.
 struct StepReport {
   bool accepted = false;              ///< false: the input was rejected and nothing changed
@@ -73,6 +80,10 @@ struct StepReport {
   std::vector<PointId> outliers;      ///< gated out (Mahalanobis) and removed
   std::vector<PointId> lost;          ///< not measured (or unpredictable) and removed
   JumpBlock jump = JumpBlock::kNone;  ///< a sudden calibration change was detected
+  /// After a jump: the 1 sigma each of the block's [dt (3), dtheta (3)] was re-opened to at
+  /// least (the re-opening's own widths, before the block's earlier variance is kept where
+  /// larger).
+  Vector6d jump_sigma = Vector6d::Zero();
   /// x_camr's rotation was contradicted by the updates beyond its covariance and its variance
   /// widened to cover the indicated shift, points kept (FilterConfig::jump_score_*; the
   /// message says by how much).
@@ -126,8 +137,9 @@ class CalibrationFilter {
   /// A sudden change of one camera's mounting found outside the filter (the front end finds
   /// no stereo pair any more, CalibrationPipeline): the block's uncertainty is widened to at
   /// least the given sigmas and decorrelated from the rest, and every point is removed (their
-  /// regressions on the block no longer hold). Returns the removed points' ids.
-  std::vector<PointId> reopen(JumpBlock block, double translation_sigma, double rotation_sigma);
+  /// regressions on the block no longer hold). @p sigma: [dt (3), dtheta (3)] of the block's
+  /// tangent error (uniformBlockSigmas). Returns the removed points' ids.
+  std::vector<PointId> reopen(JumpBlock block, const Vector6d& sigma);
   size_t pointCount() const { return points_.size(); }
   /// How much of the recent vehicle rotation is excitation, per axis (MotionExcitation).
   Eigen::Vector3d excitationGains() const { return excitation_.gains(); }
@@ -233,9 +245,17 @@ class CalibrationFilter {
   /// row widens x_camr's rotation variance to cover the indicated shift (FilterConfig::
   /// jump_score_*). Sets report->right_rotation_widened and its message.
   void widenRightRotationOnEvidence(StepReport* report);
-  /// widenBlock with the config's jump sigmas (the points are the caller's).
-  void reopenBlock(JumpBlock block);
-  void widenBlock(JumpBlock block, double translation_sigma, double rotation_sigma);
+  /// widenBlock with the config's jump sigmas (the points are the caller's); sets
+  /// report->jump_sigma.
+  void reopenBlock(JumpBlock block, StepReport* report);
+  /// After an x_caml jump found at once: x_caml's rotation moved by the rotation that takes
+  /// the tracked points' predicted left bearings onto the measured ones, and only the axes
+  /// that moved re-opened wide (FilterConfig::jump_fit_rotation_sigma). False (nothing
+  /// changed) when off or the fit fails; then the whole block is re-opened.
+  bool reopenLeftCameraAtFittedRotation(const std::vector<PointInnovation>& innovations,
+                                        StepReport* report);
+  /// Widens the block's variances to at least @p sigma^2 (per component) and decorrelates it.
+  void widenBlock(JumpBlock block, const Vector6d& sigma);
   void removeIndices(const std::vector<bool>& remove);
   bool repairCovariance();
   void rebuildIndex();
