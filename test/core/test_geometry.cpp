@@ -289,6 +289,13 @@ TEST(Rotation, RotationDistanceIsTheRelativeAngle) {
   EXPECT_NEAR(rotationDistance(a, b), Eigen::AngleAxisd(a.transpose() * b).angle(), 1e-13);
 }
 
+TEST(Rotation, WrapAngleKeepsASmallAngleExactly) {
+  // An error of a converged angle is tiny; wrapping must not round it (fmod(a + pi, 2 pi) -
+  // pi kept only the bits of a that survive next to pi).
+  for (double a : {1e-9, -1e-9, 3.3e-7, -2.7e-5, 1e-300}) EXPECT_EQ(wrapAngle(a), a) << a;
+  EXPECT_EQ(wrapAngle(2 * M_PI + 1e-3), (2 * M_PI + 1e-3) - 2 * M_PI);
+}
+
 TEST(Rotation, WrapAngleKnownValues) {
   EXPECT_DOUBLE_EQ(wrapAngle(0.0), 0.0);
   EXPECT_NEAR(wrapAngle(0.1), 0.1, 1e-15);

@@ -12,6 +12,7 @@
 
 #include "online_stereo_calibration/core/sim/scenario_runner.h"
 #include "online_stereo_calibration/tools/campaign_score.h"
+#include "online_stereo_calibration/tools/evaluation.h"
 
 namespace osc {
 namespace {
@@ -23,12 +24,6 @@ const double kPaperRmse[12] = {0.0608, 0.0382, 0.0132, 0.2995 * kDeg, 0.7061 * k
                                0.0044, 0.0048, 0.0037, 0.0236 * kDeg, 0.0174 * kDeg, 0.0193 * kDeg};
 const char* kNames[12] = {"xl", "yl", "zl", "roll_l", "pitch_l", "yaw_l",
                           "xr", "yr", "zr", "roll_r", "pitch_r", "yaw_r"};
-
-Vector12d parameterError(const ScenarioFrameResult& r) {
-  Vector12d e = r.parameters - r.truth;
-  for (int k : {3, 4, 5, 9, 10, 11}) e(k) = std::remainder(e(k), 2.0 * M_PI);
-  return e;
-}
 
 // Paper scenario: start errors 0.5 m / 10 deg on x_caml, 0.1 m on yr, 10 Hz, 1500 frames,
 // a 10 deg yaw step of x_caml at frame 774. Pooled over three drives (seeds) so that one
@@ -47,7 +42,7 @@ TEST(PaperScenario, BeatsTableIAndIsNotOverconfident) {
         ++jumps;
         EXPECT_EQ(r.frame, 774) << "seed " << seed << ": a jump where there was none";
       }
-      const Vector12d e = parameterError(r);
+      const Vector12d e = parameterErrors(r.parameters, r.truth);
       if (r.frame > 774 && recovered_at < 0 && std::abs(e(5)) < 0.3 * kDeg) recovered_at = r.frame;
       if (r.frame < 1000 || r.frame > 1150) continue;
       squared_error += e.cwiseAbs2();

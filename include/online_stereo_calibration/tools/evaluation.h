@@ -14,6 +14,13 @@
 
 namespace osc {
 
+/// Whether parameter @p index of the interface order [xl..yaw_l, xr..yaw_r] is an angle.
+bool isAngleParameter(int index);
+/// estimate - truth of parameter @p index, an angle wrapped to (-pi, pi] (wrapAngle).
+double parameterError(const Vector12d& estimate, const Vector12d& truth, int index);
+/// All 12 of them.
+Vector12d parameterErrors(const Vector12d& estimate, const Vector12d& truth);
+
 /// Statistics of one parameter over the window (m or rad).
 struct ParameterStatistics {
   double rmse = 0;           ///< sqrt(mean of error^2)

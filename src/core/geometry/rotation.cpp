@@ -61,9 +61,9 @@ double rotationDistance(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
 }
 
 double wrapAngle(double angle) {
-  angle = std::fmod(angle + M_PI, 2.0 * M_PI);
-  if (angle <= 0.0) angle += 2.0 * M_PI;
-  return angle - M_PI;
+  // std::remainder is exact (fmod(angle + pi) lost the low bits of a small angle).
+  angle = std::remainder(angle, 2.0 * M_PI);  // [-pi, pi]
+  return angle <= -M_PI ? angle + 2.0 * M_PI : angle;
 }
 
 }  // namespace osc

@@ -5,28 +5,17 @@
 #include <limits>
 #include <stdexcept>
 
+#include "online_stereo_calibration/tools/evaluation.h"
+
 namespace osc {
 
 namespace {
-
-double wrapAngle(double a) {
-  a = std::remainder(a, 2.0 * M_PI);  // [-pi, pi]
-  return a <= -M_PI ? a + 2.0 * M_PI : a;
-}
-
-bool isAngle(int index) { return index % 6 >= 3; }
-
-/// Estimate - truth of parameter @p p (angles wrapped).
-double parameterError(const ScenarioFrameResult& f, int p) {
-  const double e = f.parameters(p) - f.truth(p);
-  return isAngle(p) ? wrapAngle(e) : e;
-}
 
 /// |estimate - truth| / sigma per parameter; a NaN estimate or sigma is +inf.
 std::array<double, 12> errorsInSigmas(const ScenarioFrameResult& f) {
   std::array<double, 12> z{};
   for (int p = 0; p < 12; ++p) {
-    const double e = parameterError(f, p);
+    const double e = parameterError(f.parameters, f.truth, p);
     z[p] = std::abs(e) / f.sigmas(p);
     if (std::abs(e) == 0.0) z[p] = 0.0;
     if (!std::isfinite(e) || !(f.sigmas(p) >= 0.0) || std::isnan(z[p])) {
@@ -103,7 +92,7 @@ CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames,
   for (int p = 0; p < 12; ++p) {
     double sum = 0.0;
     for (size_t i = first; i < frames.size(); ++i) {
-      const double e = parameterError(frames[i], p);
+      const double e = parameterError(frames[i].parameters, frames[i].truth, p);
       sum += e * e;
     }
     score.rmse[p] = std::sqrt(sum / (frames.size() - first));

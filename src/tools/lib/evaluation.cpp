@@ -9,17 +9,21 @@
 #include "online_stereo_calibration/core/geometry/rotation.h"
 
 namespace osc {
-namespace {
 
-bool isAngle(int index) { return index % 6 >= 3; }
+bool isAngleParameter(int index) { return index % 6 >= 3; }
 
-Vector12d parameterError(const Vector12d& estimate, const Vector12d& reference) {
-  Vector12d error = estimate - reference;
-  for (int k = 0; k < 12; ++k) {
-    if (isAngle(k)) error(k) = wrapAngle(error(k));
-  }
+double parameterError(const Vector12d& estimate, const Vector12d& truth, int index) {
+  const double error = estimate(index) - truth(index);
+  return isAngleParameter(index) ? wrapAngle(error) : error;
+}
+
+Vector12d parameterErrors(const Vector12d& estimate, const Vector12d& truth) {
+  Vector12d error;
+  for (int k = 0; k < 12; ++k) error(k) = parameterError(estimate, truth, k);
   return error;
 }
+
+namespace {
 
 std::map<int, const ReferenceRow*> referenceByFrame(const std::vector<ReferenceRow>& reference) {
   std::map<int, const ReferenceRow*> by_frame;
@@ -61,10 +65,10 @@ std::string number(double value) {
 
 std::string cell(int k, const EvaluationReport& report) {
   const ParameterStatistics& s = report.parameters[k];
-  const double scale = isAngle(k) ? 1.0 / kDeg : 1.0;
+  const double scale = isAngleParameter(k) ? 1.0 / kDeg : 1.0;
   const bool below = s.rmse < paperTableRmse()[k];  // false for NaN
   char name[24];
-  std::snprintf(name, sizeof(name), "%-7s %-3s", kStateNames[k], isAngle(k) ? "deg" : "m");
+  std::snprintf(name, sizeof(name), "%-7s %-3s", kStateNames[k], isAngleParameter(k) ? "deg" : "m");
   char percent[16];
   std::snprintf(percent, sizeof(percent), "%7.1f%%", 100.0 * s.within_2sigma);
   return std::string(name) + number(s.rmse * scale) + number(paperTableRmse()[k] * scale) +
@@ -93,7 +97,7 @@ EvaluationReport evaluateWindow(const std::vector<EstimateRow>& estimates,
     if (frame < first_frame || frame > last_frame) continue;
     const auto it = truth.find(frame);
     if (it == truth.end()) continue;
-    const Vector12d error = parameterError(row->parameters, it->second->parameters);
+    const Vector12d error = parameterErrors(row->parameters, it->second->parameters);
     ++report.frames_used;
     sum_squared += error.cwiseAbs2();
     nees_sum += error.cwiseQuotient(row->sigmas).squaredNorm() / 12.0;
@@ -132,7 +136,7 @@ int framesToConverge(const std::vector<EstimateRow>& estimates,
     if (frame < from_frame) continue;
     const auto it = truth.find(frame);
     if (it == truth.end()) continue;
-    const double error = parameterError(row->parameters, it->second->parameters)(parameter_index);
+    const double error = parameterError(row->parameters, it->second->parameters, parameter_index);
     if (std::abs(error) <= tolerance) {
       if (converged_since < 0) converged_since = frame;
     } else {
