@@ -201,8 +201,8 @@ bool StereoCalibrationEstimator::restartFromMotion(
       Eigen::Matrix3d::Identity() * translation_sigma * translation_sigma;
   covariance.template block<3, 3>(kCaml + kRotation, kCaml + kRotation) = restart.covariance;
   filter_.reset(start, covariance);
-  anchorHere(JumpBlock::kNone,
-             Vector6d::Zero());  // a start: both blocks re-linearised as after one
+  // A start: both blocks re-linearised as after one.
+  anchorHere(JumpBlock::kNone, Vector6d::Zero());
   report->mounting_rotation_from_motion = true;
   const Eigen::Vector3d before = rpyFromRotation(now.T_veh_caml.linear()) * 180.0 / M_PI;
   const Eigen::Vector3d after = rpyFromRotation(restart.R_veh_caml) * 180.0 / M_PI;

@@ -80,9 +80,8 @@ struct StepReport {
   std::vector<PointId> outliers;      ///< gated out (Mahalanobis) and removed
   std::vector<PointId> lost;          ///< not measured (or unpredictable) and removed
   JumpBlock jump = JumpBlock::kNone;  ///< a sudden calibration change was detected
-  /// After a jump: the 1 sigma each of the block's [dt (3), dtheta (3)] was re-opened to at
-  /// least (the re-opening's own widths, before the block's earlier variance is kept where
-  /// larger).
+  /// After a jump: the sigmas the block's [dt (3), dtheta (3)] were re-opened to (each
+  /// component keeps its earlier sigma where that was larger).
   Vector6d jump_sigma = Vector6d::Zero();
   /// x_camr's rotation was contradicted by the updates beyond its covariance and its variance
   /// widened to cover the indicated shift, points kept (FilterConfig::jump_score_*; the
@@ -251,7 +250,8 @@ class CalibrationFilter {
   /// After an x_caml jump found at once: x_caml's rotation moved by the rotation that takes
   /// the tracked points' predicted left bearings onto the measured ones, and only the axes
   /// that moved re-opened wide (FilterConfig::jump_fit_rotation_sigma). False (nothing
-  /// changed) when off or the fit fails; then the whole block is re-opened.
+  /// changed) when off, when the fit fails or when the turn does not explain at least
+  /// jump_rejected_fraction of the points; then the whole block is re-opened.
   bool reopenLeftCameraAtFittedRotation(const std::vector<PointInnovation>& innovations,
                                         StepReport* report);
   /// Widens the block's variances to at least @p sigma^2 (per component) and decorrelates it.
