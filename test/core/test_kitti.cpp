@@ -26,6 +26,7 @@
 #include "online_stereo_calibration/core/geometry/camera_model.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
 #include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
+#include "online_stereo_calibration/tools/evaluation.h"
 #include "online_stereo_calibration/tools/kitti_sequence.h"
 
 namespace osc {
@@ -59,11 +60,7 @@ KittiRun runKitti(const KittiSequence& sequence, const Vector12d& start_error,
     const PipelineResult r =
         pipeline.process(left, right, k > 0 ? sequence.motion(k) : MotionIncrement());
     EXPECT_TRUE(r.processed) << "frame " << k << ": " << r.status;
-    Vector12d e = r.estimate.parameters - truth;
-    for (int i = 0; i < 12; ++i) {
-      if (i % 6 >= 3) e(i) = std::atan2(std::sin(e(i)), std::cos(e(i)));
-    }
-    run.errors.push_back(e);
+    run.errors.push_back(parameterErrors(r.estimate.parameters, truth));
     run.sigmas.push_back(r.estimate.sigmas());
     run.points.push_back(static_cast<int>(r.estimate.tracked_points));
     run.restarted.push_back(r.estimator.relinearized);

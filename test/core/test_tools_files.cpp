@@ -109,20 +109,6 @@ const std::string kValidYaml =
 // Calibration YAML
 // ---------------------------------------------------------------------------------------
 
-TEST(Evaluation, ParameterErrorsWrapAnglesAcrossPiAndLeaveTranslations) {
-  Vector12d estimate = Vector12d::Zero(), truth = Vector12d::Zero();
-  estimate(5) = 179.0 * kDeg;  // yaw_l just below +180 deg ...
-  truth(5) = -179.0 * kDeg;    // ... truth just above -180 deg: 2 deg apart, not 358
-  estimate(9) = 1e-9;          // roll_r: a converged error, kept to the last bit
-  estimate(1) = 7.0;           // yl: a translation is never wrapped
-  const Vector12d e = parameterErrors(estimate, truth);
-  EXPECT_NEAR(e(5), -2.0 * kDeg, 1e-12);
-  EXPECT_EQ(e(9), 1e-9);
-  EXPECT_EQ(e(1), 7.0);
-  EXPECT_EQ(parameterError(estimate, truth, 5), e(5));
-  for (int k = 0; k < 12; ++k) EXPECT_EQ(isAngleParameter(k), k % 6 >= 3) << k;
-}
-
 TEST(CalibrationFile, ParsesTheInterfaceExample) {
   const CalibrationFile file = parseCalibrationYaml(kValidYaml + "other_key: 3\n", "inline");
   Vector12d expected;
@@ -577,6 +563,20 @@ TEST(EstimatesCsv, ReaderRejectsBadHeaderAndBadFields) {
 // ---------------------------------------------------------------------------------------
 // Evaluation
 // ---------------------------------------------------------------------------------------
+
+TEST(Evaluation, ParameterErrorsWrapAnglesAcrossPiAndLeaveTranslations) {
+  Vector12d estimate = Vector12d::Zero(), truth = Vector12d::Zero();
+  estimate(5) = 179.0 * kDeg;  // yaw_l just below +180 deg ...
+  truth(5) = -179.0 * kDeg;    // ... truth just above -180 deg: 2 deg apart, not 358
+  estimate(9) = 1e-9;          // roll_r: a converged error, kept to the last bit
+  estimate(1) = 7.0;           // yl: a translation is never wrapped
+  const Vector12d e = parameterErrors(estimate, truth);
+  EXPECT_NEAR(e(5), -2.0 * kDeg, 1e-12);
+  EXPECT_EQ(e(9), 1e-9);
+  EXPECT_EQ(e(1), 7.0);
+  EXPECT_EQ(parameterError(estimate, truth, 5), e(5));
+  for (int k = 0; k < 12; ++k) EXPECT_EQ(isAngleParameter(k), k % 6 >= 3) << k;
+}
 
 EstimateRow estimate(int frame, const Vector12d& parameters, double sigma) {
   EstimateRow row;

@@ -19,6 +19,7 @@
 #include "online_stereo_calibration/tools/calibration_file.h"
 #include "online_stereo_calibration/tools/drive_simulation.h"
 #include "online_stereo_calibration/tools/estimates_csv.h"
+#include "online_stereo_calibration/tools/evaluation.h"
 #include "online_stereo_calibration/tools/scenario_file.h"
 #include "online_stereo_calibration/tools/tum_trajectory.h"
 
@@ -310,8 +311,7 @@ TEST(BagTools, SimulateThenEvaluateShortDrive) {
     int n = 0;
     for (const auto& e : estimates) {
       if (e.frame < 40 || e.frame > 59) continue;
-      double error = e.parameters(p) - reference[e.frame].parameters(p);
-      if (p % 6 >= 3) error = std::remainder(error, 2 * M_PI);
+      const double error = osc::parameterError(e.parameters, reference[e.frame].parameters, p);
       sum += error * error;
       ++n;
     }

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "online_stereo_calibration/tools/evaluation.h"
+
 namespace osc {
 
 std::vector<std::pair<std::size_t, std::size_t>> pairByExactStamp(
@@ -31,10 +33,10 @@ int detectStepFrame(const std::vector<ReferenceRow>& reference, double translati
                     double angle_threshold) {
   for (std::size_t k = 1; k < reference.size(); ++k) {
     for (int p = 0; p < 12; ++p) {
-      double difference = reference[k].parameters(p) - reference[k - 1].parameters(p);
-      const bool angle = p % 6 >= 3;
-      if (angle) difference = std::remainder(difference, 2.0 * M_PI);
-      if (std::abs(difference) > (angle ? angle_threshold : translation_threshold)) {
+      const double difference =
+          parameterError(reference[k].parameters, reference[k - 1].parameters, p);
+      const double threshold = isAngleParameter(p) ? angle_threshold : translation_threshold;
+      if (std::abs(difference) > threshold) {
         return reference[k].frame;
       }
     }

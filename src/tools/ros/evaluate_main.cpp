@@ -347,15 +347,15 @@ int evaluateBag(const Options& options) {
                        [&](const osc::ReferenceRow& r) { return r.frame == step_frame; });
       for (int p = 0; p < 12 && before != reference.begin(); ++p) {
         const double d = std::abs((before->parameters(p) - (before - 1)->parameters(p)) *
-                                  (p % 6 >= 3 ? 1.0 : 0.1));
+                                  (osc::isAngleParameter(p) ? 1.0 : 0.1));
         if (d > largest) largest = d, stepped = p;
       }
-      const double tolerance = stepped % 6 >= 3 ? 0.3 * M_PI / 180.0 : 0.03;
+      const double tolerance = osc::isAngleParameter(stepped) ? 0.3 * M_PI / 180.0 : 0.03;
       const int back = osc::framesToConverge(estimates, reference, stepped, tolerance, step_frame);
       text << "Step at frame " << step_frame << " (largest in "
            << osc::estimatesCsvColumns()[2 + stepped] << "): within "
-           << (stepped % 6 >= 3 ? "0.3 deg" : "3 cm") << " from frame " << back << " on ("
-           << (back >= 0 ? back - step_frame : -1) << " frames to converge)\n";
+           << (osc::isAngleParameter(stepped) ? "0.3 deg" : "3 cm") << " from frame " << back
+           << " on (" << (back >= 0 ? back - step_frame : -1) << " frames to converge)\n";
     }
   } else {
     const osc::EstimateRow& last = estimates.back();
