@@ -61,8 +61,8 @@ const char* kDescription =
     "frames_beyond_5sigma,frames_beyond_5sigma_unseen,max_z,max_z_parameter,\n"
     "first_frame_beyond_5sigma,nees_mean,converged_frame,frames_converged,\n"
     "frames_converged_beyond_3sigma,time_ms_median, rmse_<p> for the 12 parameters over the\n"
-    "last 150 frames (m, rad), the drawn settings, run_s (wall time of the run) and status\n"
-    "(ok / failed: why).\n"
+    "last 150 frames (m, rad), mean_z_<p> (mean signed error / sigma from frame 30 on), the\n"
+    "drawn settings, run_s (wall time of the run) and status (ok / failed: why).\n"
     "  share_within_3sigma: share of frames from frame 30 on with all 12 errors (estimate -\n"
     "    truth, angles wrapped) within 3 reported sigmas; frames_beyond_5sigma: frames from 30\n"
     "    on with some error beyond 5 sigma (first_frame_beyond_5sigma: the first, -1 if none);\n"
@@ -83,7 +83,8 @@ const char* kDescription =
     "odo_rotation_bias_deg_s, odo_velocity_bias_mps, blind_s, moving_fraction,\n"
     "moving_speed_mps; with --images also image_noise, image_blur_px, image_flicker.\n"
     "DIR/summary.txt: runs, share honest (share_within_3sigma >= 0.95 and\n"
-    "frames_beyond_5sigma = 0), the worst runs with seeds and settings, and the same by each\n"
+    "frames_beyond_5sigma = 0), each parameter's mean_z over the runs with its standard\n"
+    "error (far from 0: biased), the worst runs with seeds and settings, and the same by each\n"
     "setting's bucket. DIR/campaign.png (scripts/plot_campaign.py): share_within_3sigma and\n"
     "max_z against start errors, baseline, motion, mounting and event.";
 

@@ -295,6 +295,11 @@ TEST(CampaignScore, CountsFramesAgainstTheSigmasFromFrame30) {
   EXPECT_NEAR(s.rmse[0], std::sqrt((30 * 1.0 + 70 * 1e-4) / 100), 1e-12);
   // yaw_l's errors, wrapped: 0.01 except -0.04 in frame 40.
   EXPECT_NEAR(s.rmse[5], std::sqrt((99 * 1e-4 + 16e-4) / 100), 1e-9);
+  // Signed errors in sigmas over frames 30-99 only (xl's 100 sigmas before are not scored);
+  // yaw_l's wrapped across pi.
+  EXPECT_NEAR(s.mean_z[0], 1.0, 1e-9);
+  EXPECT_NEAR(s.mean_z[5], (69.0 - 4.0) / 70.0, 1e-6);
+  EXPECT_NEAR(s.mean_z[10], (68.0 + 6.0 - 7.5) / 70.0, 1e-9);
 }
 
 // A knock at frame 50 inside a blind stretch 45-60: frames 50-60 are beyond 5 sigma because
@@ -342,6 +347,8 @@ TEST(CampaignScore, NanEstimateIsBeyondEveryBound) {
   EXPECT_EQ(s.first_frame_beyond_5sigma, 35);
   EXPECT_TRUE(std::isinf(s.max_z));
   EXPECT_EQ(s.max_z_parameter, "zl");
+  // The NaN frame is left out of zl's mean signed error, not spread over it.
+  EXPECT_EQ(s.mean_z[2], 0.0);
   EXPECT_THROW(
       scoreCampaignRun(std::vector<ScenarioFrameResult>(frames.begin(), frames.begin() + 30)),
       std::invalid_argument);
@@ -366,6 +373,7 @@ TEST(CampaignCsv, RowsRoundTripAndFailedRowsKeepTheirColumns) {
   row.score.frames_converged_beyond_3sigma = 7;
   row.score.time_ms_median = 0.75;
   for (int p = 0; p < 12; ++p) row.score.rmse[p] = 0.001 * (p + 1);
+  for (int p = 0; p < 12; ++p) row.score.mean_z[p] = 0.25 * (p - 6);
   row.settings = drawCampaignRun(ranges, 4, 11, 100, false).settings;
   row.run_seconds = 1.25;
   const CampaignRow failed = failedCampaignRow(5, 12, 100, {}, "boom, twice\nagain");
@@ -383,14 +391,66 @@ TEST(CampaignCsv, RowsRoundTripAndFailedRowsKeepTheirColumns) {
   EXPECT_EQ(back[0].score.frames_converged, 9);
   EXPECT_EQ(back[0].score.frames_converged_beyond_3sigma, 7);
   EXPECT_EQ(back[0].score.rmse[11], 0.012);
+  EXPECT_EQ(back[0].score.mean_z, row.score.mean_z);
   EXPECT_EQ(back[0].settings, row.settings);
   EXPECT_TRUE(back[0].ok());
   EXPECT_FALSE(back[0].honest());
   EXPECT_FALSE(back[1].ok());
   EXPECT_EQ(back[1].status, "failed: boom; twice again");
   EXPECT_TRUE(std::isnan(back[1].score.share_within_3sigma));
+  EXPECT_TRUE(std::isnan(back[1].score.mean_z[7]));
   EXPECT_EQ(back[1].settings.size(), names.size());
   EXPECT_THROW(parseCampaignCsv("run,seed\n1,2\n", "bad.csv"), std::runtime_error);
+
+  // A file written before the mean_z_<p> columns (a campaign resumed after an update) reads
+  // back with NaN there and everything else in its place.
+  const auto withoutMeanZ = [](const std::string& line) {
+    std::vector<std::string> fields;
+    std::stringstream in(line);
+    for (std::string f; std::getline(in, f, ',');) fields.push_back(f);
+    const size_t first = 14 + 12;  // score columns, then rmse_<p>
+    fields.erase(fields.begin() + first, fields.begin() + first + 12);
+    std::string joined;
+    for (const std::string& f : fields) joined += (joined.empty() ? "" : ",") + f;
+    return joined;
+  };
+  const std::vector<CampaignRow> old =
+      parseCampaignCsv(withoutMeanZ(campaignCsvHeader(names)) + "\n" +
+                           withoutMeanZ(formatCampaignCsvLine(row, names)) + "\n",
+                       "old.csv");
+  ASSERT_EQ(old.size(), 1u);
+  EXPECT_EQ(old[0].score.rmse[11], 0.012);
+  EXPECT_TRUE(std::isnan(old[0].score.mean_z[0]));
+  EXPECT_EQ(old[0].settings, row.settings);
+  EXPECT_EQ(old[0].run_seconds, 1.25);
+}
+
+// The mean signed error of a parameter over the runs, with its standard error from the runs'
+// spread: yr a sigma low in every run is biased, zr's means scattered about 0 are not; a
+// failed run does not count.
+TEST(CampaignSummary, ParameterBiasIsTheRunsMeanSignedErrorWithItsStandardError) {
+  std::vector<CampaignRow> rows;
+  const std::vector<double> yr = {-1.0, -1.2, -0.8, -1.0}, zr = {0.1, -0.1, 0.2, -0.2};
+  for (size_t i = 0; i < yr.size(); ++i) {
+    CampaignRow row;
+    row.run = static_cast<int>(i);
+    row.score.mean_z.fill(0.0);
+    row.score.mean_z[7] = yr[i];
+    row.score.mean_z[8] = zr[i];
+    rows.push_back(row);
+  }
+  rows.push_back(failedCampaignRow(9, 9, 100, {}, "crashed"));
+  const std::array<ParameterBias, 12> bias = campaignParameterBias(rows);
+  EXPECT_EQ(bias[7].runs, 4);
+  EXPECT_NEAR(bias[7].mean, -1.0, 1e-12);
+  EXPECT_NEAR(bias[7].standard_error, std::sqrt(0.08 / 3.0 / 4.0), 1e-12);
+  EXPECT_TRUE(bias[7].significant());
+  EXPECT_NEAR(bias[8].mean, 0.0, 1e-12);
+  EXPECT_FALSE(bias[8].significant());
+  EXPECT_FALSE(bias[0].significant());  // all 0: no spread, no bias
+  const std::string summary = formatCampaignSummary(rows, 1);
+  EXPECT_NE(summary.find("yr -1.00 +- 0.08*"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("zr +0.00 +- 0.09 "), std::string::npos) << summary;
 }
 
 TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
@@ -954,6 +1014,10 @@ TEST(Campaign, FourRunsOf100FramesWriteTheDocumentedColumnsAndResume) {
   for (const char* p : {"xl", "yl", "zl", "roll_l", "pitch_l", "yaw_l", "xr", "yr", "zr", "roll_r",
                         "pitch_r", "yaw_r"}) {
     expected.push_back(std::string("rmse_") + p);
+  }
+  for (const char* p : {"xl", "yl", "zl", "roll_l", "pitch_l", "yaw_l", "xr", "yr", "zr", "roll_r",
+                        "pitch_r", "yaw_r"}) {
+    expected.push_back(std::string("mean_z_") + p);
   }
   for (const std::string& name : campaignSettingNames(false)) expected.push_back(name);
   expected.push_back("run_s");

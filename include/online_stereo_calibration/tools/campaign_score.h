@@ -52,6 +52,12 @@ struct CampaignScore {
   double time_ms_median = 0.0;
   /// RMSE of each parameter over the last kCampaignRmseFrames frames (m, rad).
   std::array<double, 12> rmse{};
+  /// Mean over frames >= kCampaignFirstScoredFrame of each parameter's signed error / sigma
+  /// (frames where it is not finite left out; NaN if none is). Within a run the errors are
+  /// correlated in time, so one run's mean says little; across many runs of a consistent
+  /// filter these means average to about 0, and a parameter whose average is not is biased
+  /// (the filter errs to one side more than its sigma allows; campaign_summary.h).
+  std::array<double, 12> mean_z{};
 };
 
 /// Scores a run's per-frame results (in frame order; at least one frame from

@@ -75,6 +75,7 @@ CampaignRow failedCampaignRow(int run, unsigned seed, int frames, const Campaign
   row.score.frames_converged = row.score.frames_converged_beyond_3sigma = -1;
   row.score.max_z_parameter = "-";
   row.score.rmse.fill(nan);
+  row.score.mean_z.fill(nan);
   row.settings = settings;
   row.status = "failed: " + clean(reason);
   return row;
@@ -83,6 +84,7 @@ CampaignRow failedCampaignRow(int run, unsigned seed, int frames, const Campaign
 std::vector<std::string> campaignCsvColumns(const std::vector<std::string>& setting_names) {
   std::vector<std::string> columns = scoreColumns();
   for (const std::string& p : campaignParameterNames()) columns.push_back("rmse_" + p);
+  for (const std::string& p : campaignParameterNames()) columns.push_back("mean_z_" + p);
   columns.insert(columns.end(), setting_names.begin(), setting_names.end());
   columns.push_back("run_s");
   columns.push_back("status");
@@ -107,6 +109,7 @@ std::string formatCampaignCsvLine(const CampaignRow& row,
        << number(s.nees_mean) << ',' << s.converged_frame << ',' << s.frames_converged << ','
        << s.frames_converged_beyond_3sigma << ',' << number(s.time_ms_median);
   for (double r : s.rmse) line << ',' << number(r);
+  for (double z : s.mean_z) line << ',' << number(z);
   for (size_t i = 0; i < setting_names.size(); ++i) {
     line << ',';
     if (row.settings.empty()) continue;
@@ -137,6 +140,12 @@ std::vector<CampaignRow> parseCampaignCsv(const std::string& text, const std::st
   if (!header_ok) {
     throw std::runtime_error(source_name +
                              ": line 1: not a campaign CSV header (run,seed,...,status)");
+  }
+  // The mean_z_<p> columns came later (session 32): a file written before has none, and its
+  // rows read back with NaN there.
+  bool has_mean_z = header.size() >= fixed + 12 + 2;
+  for (size_t p = 0; has_mean_z && p < 12; ++p) {
+    has_mean_z = header[fixed + p] == "mean_z_" + campaignParameterNames()[p];
   }
   std::vector<CampaignRow> rows;
   int line_number = 1;
@@ -181,6 +190,10 @@ std::vector<CampaignRow> parseCampaignCsv(const std::string& text, const std::st
     row.score.frames_converged_beyond_3sigma = static_cast<int>(integer(column++));
     row.score.time_ms_median = real(column++);
     for (int p = 0; p < 12; ++p) row.score.rmse[p] = real(column++);
+    row.score.mean_z.fill(std::numeric_limits<double>::quiet_NaN());
+    if (has_mean_z) {
+      for (int p = 0; p < 12; ++p) row.score.mean_z[p] = real(column++);
+    }
     for (; column + 2 < f.size(); ++column) row.settings.emplace_back(header[column], f[column]);
     row.run_seconds = real(column++);
     row.status = f[column];

@@ -47,6 +47,8 @@ CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames,
   int scored = 0, within = 0;
   double nees_sum = 0.0;
   int max_index = 0;
+  std::array<double, 12> signed_z_sum{};
+  std::array<int, 12> signed_z_count{};
   for (const ScenarioFrameResult& f : frames) {
     const std::array<double, 12> z = errorsInSigmas(f);
     const auto someBeyond = [&z](double bound) {
@@ -67,6 +69,12 @@ CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames,
       }
     }
     within += !some_beyond_3;
+    for (int p = 0; p < 12; ++p) {
+      const double signed_z = parameterError(f.parameters, f.truth, p) / f.sigmas(p);
+      if (!std::isfinite(signed_z)) continue;
+      signed_z_sum[p] += signed_z;
+      ++signed_z_count[p];
+    }
     if (someBeyond(5.0)) {
       ++score.frames_beyond_5sigma;
       score.frames_beyond_5sigma_unseen += inFrameSpans(unseen, f.frame);
@@ -81,6 +89,10 @@ CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames,
   score.share_within_3sigma = static_cast<double>(within) / scored;
   score.max_z_parameter = campaignParameterNames()[max_index];
   score.nees_mean = nees_sum / scored;
+  for (int p = 0; p < 12; ++p) {
+    score.mean_z[p] = signed_z_count[p] > 0 ? signed_z_sum[p] / signed_z_count[p]
+                                            : std::numeric_limits<double>::quiet_NaN();
+  }
 
   std::vector<double> times;
   for (const ScenarioFrameResult& f : frames) times.push_back(f.time_ms);
