@@ -26,7 +26,11 @@ TEST(UnscentedTransform, LinearMapIsExact) {
   const Eigen::Vector3d mean(1, -1, 2);
   UnscentedResult r;
   ASSERT_TRUE(unscentedTransform(
-      mean, P, [&](const Eigen::VectorXd& x, Eigen::VectorXd* y) { *y = A * x + b; return true; },
+      mean, P,
+      [&](const Eigen::VectorXd& x, Eigen::VectorXd* y) {
+        *y = A * x + b;
+        return true;
+      },
       UnscentedParameters{}, &r));
   EXPECT_TRUE(r.mean.isApprox(A * mean + b, 1e-10));
   EXPECT_TRUE(r.covariance.isApprox(A * P * A.transpose(), 1e-10));
@@ -83,7 +87,10 @@ TEST(UnscentedTransform, FailingFunctionIsReported) {
   UnscentedResult r;
   EXPECT_FALSE(unscentedTransform(
       Eigen::VectorXd::Zero(2), Eigen::MatrixXd::Identity(2, 2),
-      [](const Eigen::VectorXd& x, Eigen::VectorXd* y) { *y = x; return x(0) < 0.1; },
+      [](const Eigen::VectorXd& x, Eigen::VectorXd* y) {
+        *y = x;
+        return x(0) < 0.1;
+      },
       UnscentedParameters{}, &r));
 }
 
@@ -92,7 +99,11 @@ TEST(UnscentedTransform, NonPdCovarianceIsRepairedNotFatal) {
   P(0, 0) = 1.0;  // second variable has zero variance
   UnscentedResult r;
   ASSERT_TRUE(unscentedTransform(
-      Eigen::VectorXd::Zero(2), P, [](const Eigen::VectorXd& x, Eigen::VectorXd* y) { *y = 2 * x; return true; },
+      Eigen::VectorXd::Zero(2), P,
+      [](const Eigen::VectorXd& x, Eigen::VectorXd* y) {
+        *y = 2 * x;
+        return true;
+      },
       UnscentedParameters{}, &r));
   EXPECT_TRUE(r.repaired_input);
   EXPECT_NEAR(r.covariance(0, 0), 4.0, 1e-9);
@@ -104,7 +115,11 @@ TEST(UnscentedTransform, NanCovarianceIsRejected) {
   P(1, 1) = std::nan("");
   UnscentedResult r;
   EXPECT_FALSE(unscentedTransform(
-      Eigen::VectorXd::Zero(2), P, [](const Eigen::VectorXd& x, Eigen::VectorXd* y) { *y = x; return true; },
+      Eigen::VectorXd::Zero(2), P,
+      [](const Eigen::VectorXd& x, Eigen::VectorXd* y) {
+        *y = x;
+        return true;
+      },
       UnscentedParameters{}, &r));
 }
 

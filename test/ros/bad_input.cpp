@@ -26,14 +26,13 @@
 #include <std_srvs/Trigger.h>
 #include <opencv2/imgproc.hpp>
 
+#include "online_stereo_calibration/core/geometry/rotation.h"
 #include "rostest_helpers.h"
 
 namespace {
 
 using online_stereo_calibration::StereoCalibration;
 using osc_test::spinUntil;
-
-double wrap(double angle) { return std::atan2(std::sin(angle), std::cos(angle)); }
 
 sensor_msgs::ImagePtr mono8(const cv::Mat& image, const ros::Time& stamp,
                             const std::string& frame) {
@@ -262,7 +261,7 @@ TEST_F(BadInput, NeverMovesTheCalibrationAndIsNamedInDiagnostics) {
     bool out = false;
     for (int i = 0; i < 12; ++i) {
       double error = d.parameters[i] - c->second.parameters[i];
-      if (i % 6 >= 3) error = wrap(error);
+      if (i % 6 >= 3) error = osc::wrapAngle(error);
       const double z = std::abs(error) / d.sigma[i];
       out = out || !(z <= 3.0);
       if (!(z <= worst_z)) {
