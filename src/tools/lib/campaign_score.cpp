@@ -11,16 +11,25 @@ namespace osc {
 
 namespace {
 
-/// |estimate - truth| / sigma per parameter; a NaN estimate or sigma is +inf.
-std::array<double, 12> errorsInSigmas(const ScenarioFrameResult& f) {
+/// (estimate - truth) / sigma per parameter: 0 for no error, +-inf for an error with a zero
+/// sigma, NaN for a NaN estimate or a NaN or negative sigma.
+std::array<double, 12> signedErrorsInSigmas(const ScenarioFrameResult& f) {
   std::array<double, 12> z{};
   for (int p = 0; p < 12; ++p) {
     const double e = parameterError(f.parameters, f.truth, p);
-    z[p] = std::abs(e) / f.sigmas(p);
-    if (std::abs(e) == 0.0) z[p] = 0.0;
-    if (!std::isfinite(e) || !(f.sigmas(p) >= 0.0) || std::isnan(z[p])) {
-      z[p] = std::numeric_limits<double>::infinity();
-    }
+    z[p] = e / f.sigmas(p);
+    if (e == 0.0) z[p] = 0.0;
+    if (!std::isfinite(e) || !(f.sigmas(p) >= 0.0)) z[p] = std::numeric_limits<double>::quiet_NaN();
+  }
+  return z;
+}
+
+/// |signed z|; what has none (NaN) is beyond every bound (+inf).
+std::array<double, 12> absoluteErrorsInSigmas(const std::array<double, 12>& signed_z) {
+  std::array<double, 12> z{};
+  for (int p = 0; p < 12; ++p) {
+    z[p] =
+        std::isnan(signed_z[p]) ? std::numeric_limits<double>::infinity() : std::abs(signed_z[p]);
   }
   return z;
 }
@@ -50,7 +59,8 @@ CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames,
   std::array<double, 12> signed_z_sum{};
   std::array<int, 12> signed_z_count{};
   for (const ScenarioFrameResult& f : frames) {
-    const std::array<double, 12> z = errorsInSigmas(f);
+    const std::array<double, 12> signed_z = signedErrorsInSigmas(f);
+    const std::array<double, 12> z = absoluteErrorsInSigmas(signed_z);
     const auto someBeyond = [&z](double bound) {
       return std::any_of(z.begin(), z.end(), [bound](double v) { return !(v <= bound); });
     };
@@ -70,9 +80,8 @@ CampaignScore scoreCampaignRun(const std::vector<ScenarioFrameResult>& frames,
     }
     within += !some_beyond_3;
     for (int p = 0; p < 12; ++p) {
-      const double signed_z = parameterError(f.parameters, f.truth, p) / f.sigmas(p);
-      if (!std::isfinite(signed_z)) continue;
-      signed_z_sum[p] += signed_z;
+      if (!std::isfinite(signed_z[p])) continue;
+      signed_z_sum[p] += signed_z[p];
       ++signed_z_count[p];
     }
     if (someBeyond(5.0)) {
