@@ -100,6 +100,10 @@ const std::vector<ParameterSpec>& filterParameterTable() {
               "1: points as inverse depth (x/z, y/z, 1/z), 0: as positions (the seed's)"),
       integer("baseline_scaled_points", &C::baseline_scaled_points, 0, 1,
               "1: points in units of the baseline (what stereo measures), 0: metric (the seed's)"),
+      integer("errors_in_variables_compensation", &C::errors_in_variables_compensation, 0, 1,
+              "1: the update compensates the bias of regressing on a point's noisy stereo depth "
+              "(the baseline estimated long; for a small baseline with a calibrated odometry "
+              "scale), 0: not (measured mixed on other drives: docs/RESULTS.md Session 33)"),
       real("max_speed_mps", &C::max_speed, 1.0, 0.0, 1e4,
            "a motion increment faster than this is rejected as corrupt"),
       real("max_angular_rate_dps", &C::max_angular_rate, kDeg, 0.0, 1e5,

@@ -48,4 +48,15 @@ Eigen::Matrix3d PointCoordinates::jacobianFromPosition(const Eigen::Vector3d& c)
   return J;
 }
 
+Eigen::Matrix<double, 3, 4> PointCoordinates::homogeneousNumerator() const {
+  Eigen::Matrix<double, 3, 4> N = Eigen::Matrix<double, 3, 4>::Zero();
+  N(0, 0) = N(1, 1) = 1.0;
+  N(2, inverse_depth_ ? 3 : 2) = 1.0;  // rho = w / d.z, or z = d.z / w
+  return N;
+}
+
+Eigen::Vector4d PointCoordinates::homogeneousDenominator() const {
+  return HomogeneousPoint::Unit(inverse_depth_ ? 2 : 3);
+}
+
 }  // namespace osc

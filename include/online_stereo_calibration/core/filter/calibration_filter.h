@@ -184,6 +184,11 @@ class CalibrationFilter {
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();  ///< in coordinates_
     Eigen::MatrixXd B;                               ///< 3 x G regression on the global error
     Eigen::Matrix3d D = Eigen::Matrix3d::Zero();
+    bool updated = false;  ///< has had a Kalman update
+    /// This step's errors-in-variables terms (errors_in_variables.h) of a point before its
+    /// first update: d B / d p_k and F_p D; empty when it is not compensated.
+    std::array<Eigen::MatrixXd, 3> regression_gradient;
+    Eigen::Matrix3d own_error_cross = Eigen::Matrix3d::Zero();
   };
   struct PointInnovation;  // defined in the .cpp
   struct Prediction;       // defined in the .cpp

@@ -38,6 +38,10 @@ class PointCoordinates {
   double depth(const Eigen::Vector3d& c) const;
   /// d c / d position at coordinates @p c (identity for positions); finite for any rho.
   Eigen::Matrix3d jacobianFromPosition(const Eigen::Vector3d& c) const;
+  /// fromHomogeneous as a formula: c = N h / (n^T h), N = homogeneousNumerator() (the rows of
+  /// h it picks), n = homogeneousDenominator() (w for positions, d.z for inverse depth).
+  Eigen::Matrix<double, 3, 4> homogeneousNumerator() const;
+  Eigen::Vector4d homogeneousDenominator() const;
 
  private:
   bool inverse_depth_;
