@@ -147,12 +147,16 @@ TEST(MeasurementScenario, ValidateRejectsSingleProblemsWithTheirFieldName) {
   p = problemsOf([](MeasurementScenario* s) { s->rate_hz = -10.0; });
   ASSERT_EQ(p.size(), 1u);
   EXPECT_NE(p[0].find("rate_hz"), std::string::npos);
+  p = problemsOf([](MeasurementScenario* s) { s->motion.yaw_phase = std::nan(""); });
+  ASSERT_EQ(p.size(), 1u);
+  EXPECT_NE(p[0].find("motion.yaw_phase"), std::string::npos);
   // Boundary values that are allowed.
   EXPECT_TRUE(problemsOf([](MeasurementScenario* s) {
                 s->pixel_noise = 0.0;
                 s->outlier_fraction = 1.0;
                 s->mean_track_length = INFINITY;
                 s->min_depth = 1.0;
+                s->motion.yaw_phase = -7.0;  // any finite phase
               }).empty());
 }
 
@@ -204,6 +208,52 @@ TEST(VehicleTrajectory, PositionIsContinuousAcrossSteeringPeriods) {
     const Eigen::Vector2d before = trajectory.groundPosition(t - 1e-9);
     const Eigen::Vector2d after = trajectory.groundPosition(t + 1e-9);
     EXPECT_LT((after - before).norm(), 1e-7) << "period " << k;
+  }
+}
+
+TEST(VehicleTrajectory, TheSteeringPhaseStartsTheDriveInItsTurnAndHalfAPeriodMirrorsIt) {
+  VehicleMotionProfile left_first, right_first, straight;
+  right_first.yaw_phase = M_PI;
+  straight.yaw_phase = M_PI / 2.0;  // yaw rate A cos(w t + pi/2) = -A sin(w t): then right
+  const VehicleTrajectory left(left_first), right(right_first), ahead(straight);
+  const double amplitude = left_first.yaw_rate_amplitude, h = 1e-4;
+  const auto rate = [h](const VehicleTrajectory& v, double t) {
+    return (v.yaw(t + h) - v.yaw(t - h)) / (2.0 * h);
+  };
+  // Every phase starts at the world's origin heading along +x.
+  for (const VehicleTrajectory* v : {&left, &right, &ahead}) {
+    EXPECT_NEAR(v->yaw(0.0), 0.0, 1e-15);
+    EXPECT_TRUE(v->pose(0.0).isApprox(Eigen::Isometry3d::Identity(), 1e-12));
+  }
+  EXPECT_NEAR(rate(left, 0.0), amplitude, 1e-6);
+  EXPECT_NEAR(rate(right, 0.0), -amplitude, 1e-6);
+  EXPECT_NEAR(rate(ahead, 0.0), 0.0, 1e-6);
+  EXPECT_LT(rate(ahead, 2.0), -0.1 * amplitude);
+  // Phase pi steers phase 0's drive mirrored in the x-z plane: yaw and y change sign, x stays
+  // (roll, pitch and heave keep their own phases).
+  for (double t = 0.0; t < 60.0; t += 0.7) {
+    EXPECT_NEAR(right.yaw(t), -left.yaw(t), 1e-12) << t;
+    const Eigen::Vector2d l = left.groundPosition(t), r = right.groundPosition(t);
+    EXPECT_NEAR(r.x(), l.x(), 1e-9) << t;
+    EXPECT_NEAR(r.y(), -l.y(), 1e-9) << t;
+    EXPECT_EQ(right.roll(t), left.roll(t));
+    EXPECT_EQ(right.heave(t), left.heave(t));
+  }
+  // The ground track still repeats every steering period (the whole-period shortcut).
+  for (int k = 1; k < 4; ++k) {
+    const double t = k * straight.yaw_period;
+    EXPECT_LT((ahead.groundPosition(t + 1e-9) - ahead.groundPosition(t - 1e-9)).norm(), 1e-7);
+  }
+}
+
+TEST(VehicleTrajectory, PhaseZeroIsTheUnshiftedSteeringBitForBit) {
+  // Scenarios written before the phase existed must drive exactly as before.
+  const VehicleMotionProfile profile;
+  ASSERT_EQ(profile.yaw_phase, 0.0);
+  const VehicleTrajectory trajectory(profile);
+  const double heading_amplitude = profile.yaw_rate_amplitude * profile.yaw_period / (2 * M_PI);
+  for (double t = 0.0; t < 100.0; t += 0.31) {
+    EXPECT_EQ(trajectory.yaw(t), heading_amplitude * std::sin(2.0 * M_PI * t / profile.yaw_period));
   }
 }
 

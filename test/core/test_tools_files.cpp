@@ -1095,7 +1095,7 @@ std::string scenarioError(const std::string& text, const std::string& directory 
 TEST(ScenarioFileCampaignKeys, ParseIntoTheMeasurementScenario) {
   const SimulationScenario s = parseScenarioYaml(
       "frames: 400\n"
-      "motion: {speed: 5, stops: [[10, 4.5], [25, 2]], stop_ramp: 1.5}\n"
+      "motion: {speed: 5, stops: [[10, 4.5], [25, 2]], stop_ramp: 1.5, yaw_phase: 3.1}\n"
       "odometry_error: {time_offset: -0.03, scale_error: 0.01, rotation_rate_bias: 1e-4,\n"
       "                 velocity_bias: 0.02, bias_correlation_time: 12}\n"
       "blind_frames: [[100, 109], [300, 300]]\n"
@@ -1110,6 +1110,7 @@ TEST(ScenarioFileCampaignKeys, ParseIntoTheMeasurementScenario) {
   EXPECT_EQ(m.motion.stops[1].duration, 2.0);
   EXPECT_EQ(m.motion.stop_ramp, 1.5);
   EXPECT_EQ(m.motion.speed, 5.0);
+  EXPECT_EQ(m.motion.yaw_phase, 3.1);
   EXPECT_EQ(m.odometry_error.time_offset, -0.03);
   EXPECT_EQ(m.odometry_error.scale_error, 0.01);
   EXPECT_EQ(m.odometry_error.rotation_rate_bias, 1e-4);
@@ -1126,6 +1127,7 @@ TEST(ScenarioFileCampaignKeys, ParseIntoTheMeasurementScenario) {
   // Left out: the preset's values.
   const SimulationScenario plain = parseScenarioYaml("frames: 400\n", "plain.yaml", ".");
   EXPECT_TRUE(plain.measurement.motion.stops.empty());
+  EXPECT_EQ(plain.measurement.motion.yaw_phase, 0.0);
   EXPECT_EQ(plain.measurement.odometry_error.scale_error, 0.0);
   EXPECT_TRUE(plain.measurement.blind_frames.empty());
 }
@@ -1137,6 +1139,7 @@ TEST(ScenarioFileCampaignKeys, ErrorsNameTheKey) {
       {"motion: {stops: [[1, x]]}\n", "motion.stops[0].duration"},
       {"motion: {stops: [[20, 1], [10, 1]]}\n", "motion.stops[1]"},
       {"motion: {stops: [[1, 2]], stop_ramp: -1}\n", "motion.stop_ramp"},
+      {"motion: {yaw_phase: .nan}\n", "motion.yaw_phase"},
       {"odometry_error: {time_ofset: 0.1}\n", "odometry_error.time_ofset"},
       {"odometry_error: 0.1\n", "odometry_error"},
       {"odometry_error: {time_offset: 0.9}\n", "odometry_error.time_offset"},

@@ -31,11 +31,11 @@ struct CampaignRunSpec {
 /// The names of the drawn-setting columns, in order (docs/campaign.md explains each):
 /// baseline_m, image_width, image_height, focal_px, lens, k1, mounting, pitch_down_deg,
 /// motion, trajectory, trajectory_start_s, speed_mps, roll_pitch_std_deg, heave_m,
-/// yaw_rate_deg_s, stops, stop_s, start_caml_m, start_caml_deg, start_baseline_percent,
-/// start_camr_m, start_camr_deg, event, event_frame, event_deg, event_mm_per_min,
-/// odo_time_offset_ms, odo_scale_percent, odo_rotation_bias_deg_s, odo_velocity_bias_mps,
-/// blind_s, moving_fraction, moving_speed_mps, and with @p images also image_noise,
-/// image_blur_px, image_flicker.
+/// yaw_rate_deg_s, yaw_phase_deg, stops, stop_s, start_caml_m, start_caml_deg,
+/// start_baseline_percent, start_camr_m, start_camr_deg, event, event_frame, event_deg,
+/// event_mm_per_min, odo_time_offset_ms, odo_scale_percent, odo_rotation_bias_deg_s,
+/// odo_velocity_bias_mps, blind_s, moving_fraction, moving_speed_mps, and with @p images also
+/// image_noise, image_blur_px, image_flicker.
 std::vector<std::string> campaignSettingNames(bool images);
 
 /// Draws run @p run with seed @p seed: every value from its range (uniform; kinds by weight),

@@ -52,6 +52,9 @@ struct CampaignRanges {
   DrawRange urban_stops{1, 2};                   ///< motion.urban_stops (integer)
   DrawRange urban_stop_duration_s{2, 10};        ///< motion.urban_stop_duration_s (each stop)
   DrawRange urban_stop_ramp_s{3, 3};             ///< motion.urban_stop_ramp_s (slow-down)
+  /// motion.yaw_phase_deg: the steering's phase at the first frame (offroad and urban; 0 starts
+  /// at the height of a left turn), from a stream of its own (see drawCampaignRun).
+  DrawRange yaw_phase_deg{0, 360};
   /// The recorded trajectories (TUM files, sorted) found in `trajectories_dir`; empty when the
   /// kind `recorded` has weight 0.
   std::vector<std::string> trajectory_files;

@@ -22,7 +22,7 @@
 /// step:              {vehicle_to_left: [6], left_to_right: [6]}
 /// drift_per_second:  {vehicle_to_left: [6], left_to_right: [6]}
 /// motion: {speed, roll_amplitude, pitch_amplitude, roll_period, pitch_period,
-///          yaw_rate_amplitude, yaw_period, heave_amplitude, heave_period, planar,
+///          yaw_rate_amplitude, yaw_period, yaw_phase, heave_amplitude, heave_period, planar,
 ///          stops: [[start, duration], ...],   # s; the vehicle stands still (in order)
 ///          stop_ramp: 1.0}                    # s of smooth slow-down / speed-up
 /// motion_rotation_noise: 3.49e-4     # rad per axis per 0.1 s (odometry white noise)

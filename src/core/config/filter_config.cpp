@@ -339,6 +339,7 @@ FilterConfig paperFilterConfig() {
   config.camr_rotation_drift_rate_sigma = 0.0;  // ... and a right camera that does not drift
   config.inverse_depth_points = 0;              // the paper's points are positions
   config.baseline_scaled_points = 0;            // ... in metres
+  config.errors_in_variables_compensation = 0;  // ... and its update is the plain UKF's
   return config;
 }
 

@@ -11,13 +11,9 @@ HomogeneousPoint PointCoordinates::homogeneous(const Eigen::Vector3d& c) const {
 }
 
 bool PointCoordinates::fromHomogeneous(const HomogeneousPoint& h, Eigen::Vector3d* c) const {
-  if (!inverse_depth_) {
-    if (!(h.w() > 0.0)) return false;
-    *c = h.head<3>() / h.w();
-    return true;
-  }
-  if (!(h.z() > 0.0)) return false;
-  *c = Eigen::Vector3d(h.x(), h.y(), h.w()) / h.z();
+  const double denominator = h(denominatorIndex());
+  if (!(denominator > 0.0)) return false;
+  *c = Eigen::Vector3d(h.x(), h.y(), h(thirdCoordinateIndex())) / denominator;
   return true;
 }
 
@@ -51,12 +47,12 @@ Eigen::Matrix3d PointCoordinates::jacobianFromPosition(const Eigen::Vector3d& c)
 Eigen::Matrix<double, 3, 4> PointCoordinates::homogeneousNumerator() const {
   Eigen::Matrix<double, 3, 4> N = Eigen::Matrix<double, 3, 4>::Zero();
   N(0, 0) = N(1, 1) = 1.0;
-  N(2, inverse_depth_ ? 3 : 2) = 1.0;  // rho = w / d.z, or z = d.z / w
+  N(2, thirdCoordinateIndex()) = 1.0;
   return N;
 }
 
 Eigen::Vector4d PointCoordinates::homogeneousDenominator() const {
-  return HomogeneousPoint::Unit(inverse_depth_ ? 2 : 3);
+  return HomogeneousPoint::Unit(denominatorIndex());
 }
 
 }  // namespace osc

@@ -59,6 +59,7 @@ void validateMotion(const VehicleMotionProfile& m, Problems* p) {
   positive(m.yaw_period, "motion.yaw_period");
   positive(m.heave_period, "motion.heave_period");
   nonNegative(m.stop_ramp, "motion.stop_ramp");
+  p->require(std::isfinite(m.yaw_phase), "motion.yaw_phase", "finite", m.yaw_phase);
 }
 
 /// Stops: each inside the drive [0, drive_end], in order, the gaps leaving room for the ramps.

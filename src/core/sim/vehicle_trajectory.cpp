@@ -65,11 +65,13 @@ void checkProfile(const VehicleMotionProfile& p) {
       throw std::invalid_argument("VehicleMotionProfile: periods must be positive and finite");
     }
   }
-  const double values[] = {p.speed, p.roll_amplitude, p.pitch_amplitude, p.yaw_rate_amplitude,
-                           p.heave_amplitude};
+  const double values[] = {p.speed,           p.roll_amplitude,
+                           p.pitch_amplitude, p.yaw_rate_amplitude,
+                           p.heave_amplitude, p.yaw_phase};
   for (double value : values) {
     if (!std::isfinite(value)) {
-      throw std::invalid_argument("VehicleMotionProfile: speed and amplitudes must be finite");
+      throw std::invalid_argument(
+          "VehicleMotionProfile: speed, amplitudes and yaw_phase must be finite");
     }
   }
   if (!(p.stop_ramp >= 0.0) || !std::isfinite(p.stop_ramp)) {
@@ -115,7 +117,11 @@ double VehicleTrajectory::yaw(double t) const { return analyticYaw(profileTime(t
 
 double VehicleTrajectory::analyticYaw(double t) const {
   const double heading_amplitude = profile_.yaw_rate_amplitude * profile_.yaw_period / (2.0 * M_PI);
-  return sinusoid(heading_amplitude, profile_.yaw_period, t);
+  // Shifted so that the heading is 0 at t = 0 whatever the phase (the world's +x); with
+  // phase 0 this is bit for bit the unshifted sinusoid (x + 0 and sin(0) = 0 are exact).
+  const double phase = profile_.yaw_phase;
+  return heading_amplitude *
+         (std::sin(2.0 * M_PI * t / profile_.yaw_period + phase) - std::sin(phase));
 }
 
 double VehicleTrajectory::roll(double t) const {

@@ -17,6 +17,8 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kRateHz = 10.0;
+/// Draw's stream of the steering phase (see Draw(seed, stream)).
+constexpr std::uint64_t kYawPhaseStream = 1;
 
 /// Draws from a fully specified generator (std::mt19937_64) with our own conversions, so that
 /// a seed gives the same values with any standard library.
@@ -31,6 +33,9 @@ class Draw {
   /// The seed goes through SplitMix64 first, so that neighbouring seeds (S + k) start the
   /// Mersenne Twister from unrelated states.
   explicit Draw(unsigned seed) : rng_(splitMix64(seed)) {}
+  /// Stream @p stream (> 0) of @p seed: unrelated to Draw(seed), so that a value added to the
+  /// campaign later leaves every value drawn before it unchanged.
+  Draw(unsigned seed, std::uint64_t stream) : rng_(splitMix64(splitMix64(seed) + stream)) {}
   /// Uniform in [0, 1).
   double unit() { return static_cast<double>(rng_() >> 11) * 0x1.0p-53; }
   double uniform(const DrawRange& r) { return r.min + (r.max - r.min) * unit(); }
@@ -96,6 +101,7 @@ std::vector<std::string> campaignSettingNames(bool images) {
                                     "roll_pitch_std_deg",
                                     "heave_m",
                                     "yaw_rate_deg_s",
+                                    "yaw_phase_deg",
                                     "stops",
                                     "stop_s",
                                     "start_caml_m",
@@ -258,6 +264,11 @@ CampaignRunSpec drawCampaignRun(const CampaignRanges& ranges, int run, unsigned 
   set("roll_pitch_std_deg", motion == "offroad" ? number(roll_pitch_std) : "-");
   set("heave_m", motion == "offroad" ? number(heave) : "-");
   set("yaw_rate_deg_s", motion == "offroad" ? number(yaw_rate) : "-");
+  // The steering's phase (added in session 34, when every drawn drive had started at the
+  // height of a left turn), from a stream of its own: the runs' other values stay as before.
+  const double yaw_phase_deg = Draw(seed, kYawPhaseStream).uniform(ranges.yaw_phase_deg);
+  if (motion != "recorded") s.motion.yaw_phase = yaw_phase_deg * kDeg;
+  set("yaw_phase_deg", motion == "recorded" ? "-" : number(yaw_phase_deg));
   set("stops", std::to_string(stops_made));
   set("stop_s", number(stop_total));
 

@@ -35,6 +35,7 @@ const std::vector<DrawRangeSpec>& drawRangeSpecs() {
       {"motion.offroad_roll_pitch_std_deg", &R::offroad_roll_pitch_std_deg, 0, 20, false},
       {"motion.offroad_heave_m", &R::offroad_heave_m, 0, 1, false},
       {"motion.offroad_yaw_rate_deg_s", &R::offroad_yaw_rate_deg_s, 0, 90, false},
+      {"motion.yaw_phase_deg", &R::yaw_phase_deg, -360, 360, false},
       {"motion.urban_speed_mps", &R::urban_speed_mps, 0, 50, false},
       {"motion.urban_stops", &R::urban_stops, 0, 10, true},
       {"motion.urban_stop_duration_s", &R::urban_stop_duration_s, 0.1, 600, false},

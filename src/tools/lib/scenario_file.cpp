@@ -287,8 +287,8 @@ void readMotion(const YAML::Node& node, VehicleMotionProfile* m, Problems* p) {
   }
   checkKeys(node, "motion.",
             {"speed", "roll_amplitude", "pitch_amplitude", "roll_period", "pitch_period",
-             "yaw_rate_amplitude", "yaw_period", "heave_amplitude", "heave_period", "planar",
-             "stops", "stop_ramp"},
+             "yaw_rate_amplitude", "yaw_period", "yaw_phase", "heave_amplitude", "heave_period",
+             "planar", "stops", "stop_ramp"},
             p);
   const std::pair<const char*, double*> fields[] = {{"speed", &m->speed},
                                                     {"roll_amplitude", &m->roll_amplitude},
@@ -297,6 +297,7 @@ void readMotion(const YAML::Node& node, VehicleMotionProfile* m, Problems* p) {
                                                     {"pitch_period", &m->pitch_period},
                                                     {"yaw_rate_amplitude", &m->yaw_rate_amplitude},
                                                     {"yaw_period", &m->yaw_period},
+                                                    {"yaw_phase", &m->yaw_phase},
                                                     {"heave_amplitude", &m->heave_amplitude},
                                                     {"heave_period", &m->heave_period},
                                                     {"stop_ramp", &m->stop_ramp}};

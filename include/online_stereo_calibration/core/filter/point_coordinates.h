@@ -44,6 +44,12 @@ class PointCoordinates {
   Eigen::Vector4d homogeneousDenominator() const;
 
  private:
+  /// The element of a homogeneous point that divides (d.z for inverse depth: a = d.x / d.z,
+  /// b = d.y / d.z, rho = w / d.z; w for positions), and the one that gives the third
+  /// coordinate over it (w: rho; d.z: z).
+  int denominatorIndex() const { return inverse_depth_ ? 2 : 3; }
+  int thirdCoordinateIndex() const { return inverse_depth_ ? 3 : 2; }
+
   bool inverse_depth_;
 };
 

@@ -49,6 +49,10 @@ struct VehicleMotionProfile {
   double yaw_rate_amplitude = 0.15;
   /// Period of the steering (s), > 0.
   double yaw_period = 23.0;
+  /// Phase of the steering at t = 0 (rad), finite: the yaw rate is
+  /// yaw_rate_amplitude * cos(2 pi t / yaw_period + yaw_phase). 0 starts at the height of a
+  /// left turn, pi of a right turn, +-pi/2 driving straight into a right / left turn.
+  double yaw_phase = 0.0;
   /// Amplitude of the vertical bump motion (m), >= 0.
   double heave_amplitude = 0.05;
   /// Period of the vertical bump motion (s), > 0.

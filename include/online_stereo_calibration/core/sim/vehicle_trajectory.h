@@ -13,8 +13,10 @@ namespace osc {
 /// T_world_veh(t) for a VehicleMotionProfile. The world frame is z up with the vehicle at
 /// the origin, heading along +x, at t = 0.
 ///
-/// - yaw(t) = yaw_rate_amplitude * yaw_period / (2 pi) * sin(2 pi t / yaw_period), so the yaw
-///   rate is yaw_rate_amplitude * cos(2 pi t / yaw_period) and the heading swings about +x;
+/// - yaw(t) = yaw_rate_amplitude * yaw_period / (2 pi) * (sin(2 pi t / yaw_period + phase)
+///   - sin(phase)) with phase = yaw_phase, so the yaw rate is
+///   yaw_rate_amplitude * cos(2 pi t / yaw_period + phase), the heading is 0 at t = 0 and
+///   swings about +x (about +x + sin(phase) times the amplitude);
 /// - the ground track (x, y) is the integral of speed * (cos yaw, sin yaw): constant speed;
 /// - roll, pitch and heave (z) are sinusoids of their own periods (zero when planar);
 /// - rotation R = Rz(yaw) * Ry(pitch) * Rx(roll).
