@@ -469,6 +469,10 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
     if (result.estimator.too_few_points && warning.rfind("too few points", 0) == 0) {
       diagnostics_->recordProblem("too few points to update", warning);
     }
+    if (result.estimator.no_point_measurable &&
+        warning.rfind("no tracked point could be predicted", 0) == 0) {
+      diagnostics_->recordProblem("no point measurable", warning);
+    }
     if (result.estimator.baseline_from_motion &&
         warning.rfind("baseline length from motion", 0) == 0) {
       diagnostics_->recordProblem("baseline length from motion", warning);

@@ -80,6 +80,11 @@ struct FrameReport {
   /// calibration was predicted, not updated, and the tracked points start afresh (the
   /// warning is given in the first such pair of a stretch).
   bool too_few_points = false;
+  /// Every tracked point was measured in both images, yet none could be predicted (some sigma
+  /// point of it behind a camera: its depth or x_camr's rotation far too uncertain), in
+  /// 10 pairs in a row: nothing is learned while it lasts. Set (and
+  /// warned) in the pair that completes such a stretch.
+  bool no_point_measurable = false;
   /// x_camr's translation was restarted with the baseline's length measured from the left
   /// camera's motion (FilterConfig::baseline_from_motion; no point could be initialised with
   /// the guess's; the warning names the old and new length); tracks reset.
@@ -224,6 +229,9 @@ class StereoCalibrationEstimator {
   bool reopenLeftCameraAfterGap(const MotionIncrement& motion, FrameReport* report);
   /// What a reset forgets besides the filter: the evidence on the baseline, the knock and
   /// few-points streaks, the hand-eye pairs, the unobserved stretch.
+  /// Counts the pairs whose @p tracked points were all measured and none predictable, and
+  /// warns (FrameReport::no_point_measurable) at the kUnmeasurablePairsToWarn-th in a row.
+  void warnIfNoPointMeasurable(const std::vector<PointMeasurement>& tracked, FrameReport* report);
   void forgetDriveEvidence();
   /// The hand-eye start (mounting_from_motion.h): feeds the frame's motion pair; once the
   /// rotation is determined and far from x_caml's, starts the filter afresh from the guess
@@ -254,6 +262,9 @@ class StereoCalibrationEstimator {
   bool has_previous_frame_ = false;
   /// The last pair had too few stereo pairs to update (FrameReport::too_few_points).
   bool held_for_few_points_ = false;
+  /// Pairs in a row whose tracked points were all measured and none predictable
+  /// (FrameReport::no_point_measurable).
+  int unmeasurable_pairs_ = 0;
   /// Pairs in a row whose stereo pairs contradicted x_camr's epipolar lines.
   int pairs_off_epipolar_lines_ = 0;
   /// s without a point measured so far (countUnobservedTime).
