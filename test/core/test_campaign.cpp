@@ -553,10 +553,11 @@ TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
 
 /// Run @p run (of @p frames frames) of the shipped ranges (config/campaign.yaml), with the
 /// events' kinds replaced by @p events when given. An error in the spec if the file's events
-/// changed. The steering phase is held at 0 (a left turn at frame 0), as it was when the runs
-/// these tests trace were drawn and written up in docs/RESULTS.md: the phase has a random
-/// stream of its own, so every other value of the run is the one drawn then.
-CampaignRunSpec shippedRun(int run, const std::string& events = "", int frames = 600) {
+/// changed. The steering phase is held at 0 (a left turn at frame 0) unless @p drawn_phase, as
+/// it was when the runs these tests trace were drawn and written up in docs/RESULTS.md: the
+/// phase has a random stream of its own, so every other value of the run is the one drawn then.
+CampaignRunSpec shippedRun(int run, const std::string& events = "", int frames = 600,
+                           bool drawn_phase = false) {
   const std::string dir = std::string(OSC_SOURCE_DIR) + "/config";
   CampaignInputs inputs;
   inputs.ranges_text = readTextFile(dir + "/campaign.yaml");
@@ -571,7 +572,7 @@ CampaignRunSpec shippedRun(int run, const std::string& events = "", int frames =
     inputs.ranges_text.replace(at, shipped.size(), events);
   }
   inputs.ranges = parseCampaignRanges(inputs.ranges_text, "campaign.yaml", dir);
-  inputs.ranges.yaw_phase_deg = {0.0, 0.0};
+  if (!drawn_phase) inputs.ranges.yaw_phase_deg = {0.0, 0.0};
   inputs.frames = frames;
   return drawCampaignRun(inputs, run);
 }
@@ -619,12 +620,7 @@ TEST(Campaign, AStallWithEveryTrackedPointUnmeasurableIsWarnedOnce) {
   // estimator did not say. Now it warns once, in the tenth such pair in a row; with phase 0
   // the run keeps its points and never warns.
   const std::string prefix = "no tracked point could be predicted";
-  const std::string dir = std::string(OSC_SOURCE_DIR) + "/config";
-  CampaignInputs inputs;
-  inputs.ranges_text = readTextFile(dir + "/campaign.yaml");
-  inputs.ranges = parseCampaignRanges(inputs.ranges_text, "campaign.yaml", dir);
-  inputs.frames = 600;
-  const CampaignRunSpec drawn = drawCampaignRun(inputs, 92);
+  const CampaignRunSpec drawn = shippedRun(92, "", 600, /*drawn_phase=*/true);
   ASSERT_TRUE(drawn.error.empty()) << drawn.error;
   ASSERT_NEAR(drawn.scenario.motion.yaw_phase * 180.0 / M_PI, 6.479, 1e-3);
   const std::vector<int> stalled = framesWarning(drawn, prefix);

@@ -89,6 +89,7 @@ void checkProfile(const VehicleMotionProfile& p) {
 
 VehicleTrajectory::VehicleTrajectory(const VehicleMotionProfile& profile) : profile_(profile) {
   checkProfile(profile_);
+  sin_yaw_phase_ = std::sin(profile_.yaw_phase);
   period_displacement_ = integrateGroundTrack(profile_.yaw_period);
 }
 
@@ -119,9 +120,8 @@ double VehicleTrajectory::analyticYaw(double t) const {
   const double heading_amplitude = profile_.yaw_rate_amplitude * profile_.yaw_period / (2.0 * M_PI);
   // Shifted so that the heading is 0 at t = 0 whatever the phase (the world's +x); with
   // phase 0 this is bit for bit the unshifted sinusoid (x + 0 and sin(0) = 0 are exact).
-  const double phase = profile_.yaw_phase;
   return heading_amplitude *
-         (std::sin(2.0 * M_PI * t / profile_.yaw_period + phase) - std::sin(phase));
+         (std::sin(2.0 * M_PI * t / profile_.yaw_period + profile_.yaw_phase) - sin_yaw_phase_);
 }
 
 double VehicleTrajectory::roll(double t) const {

@@ -81,9 +81,9 @@ struct FrameReport {
   /// warning is given in the first such pair of a stretch).
   bool too_few_points = false;
   /// Every tracked point was measured in both images, yet none could be predicted (some sigma
-  /// point of it behind a camera: its depth or x_camr's rotation far too uncertain), in
-  /// 10 pairs in a row: nothing is learned while it lasts. Set (and
-  /// warned) in the pair that completes such a stretch.
+  /// point of it behind a camera: its depth or x_camr's rotation far too uncertain), in 10
+  /// pairs in a row: nothing is learned while it lasts. Set (and warned) in the pair that
+  /// completes such a stretch.
   bool no_point_measurable = false;
   /// x_camr's translation was restarted with the baseline's length measured from the left
   /// camera's motion (FilterConfig::baseline_from_motion; no point could be initialised with
@@ -227,11 +227,11 @@ class StereoCalibrationEstimator {
   /// dropped into report->dropped, FrameReport::left_camera_reopened_after_gap). True if it
   /// did.
   bool reopenLeftCameraAfterGap(const MotionIncrement& motion, FrameReport* report);
-  /// What a reset forgets besides the filter: the evidence on the baseline, the knock and
-  /// few-points streaks, the hand-eye pairs, the unobserved stretch.
   /// Counts the pairs whose @p tracked points were all measured and none predictable, and
   /// warns (FrameReport::no_point_measurable) at the kUnmeasurablePairsToWarn-th in a row.
   void warnIfNoPointMeasurable(const std::vector<PointMeasurement>& tracked, FrameReport* report);
+  /// What a reset forgets besides the filter: the evidence on the baseline, the knock,
+  /// few-points and unmeasurable streaks, the hand-eye pairs, the unobserved stretch.
   void forgetDriveEvidence();
   /// The hand-eye start (mounting_from_motion.h): feeds the frame's motion pair; once the
   /// rotation is determined and far from x_caml's, starts the filter afresh from the guess

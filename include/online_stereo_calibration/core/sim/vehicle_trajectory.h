@@ -67,6 +67,8 @@ class VehicleTrajectory {
   Eigen::Vector2d integrateGroundTrack(double tau) const;
 
   VehicleMotionProfile profile_;
+  /// sin(yaw_phase): analyticYaw subtracts it so that the heading is 0 at t = 0.
+  double sin_yaw_phase_ = 0.0;
   /// Ground-track displacement over one full steering period (yaw is periodic, so the track
   /// repeats itself shifted by this vector).
   Eigen::Vector2d period_displacement_;
