@@ -14,8 +14,10 @@
 #include <sstream>
 #include <string>
 
+#include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/geometry/pose_interpolation.h"
+#include "online_stereo_calibration/core/sim/measurement_simulator.h"
 #include "online_stereo_calibration/core/sim/scenario_runner.h"
 #include "online_stereo_calibration/tools/campaign.h"
 #include "online_stereo_calibration/tools/campaign_csv.h"
@@ -601,11 +603,12 @@ std::string scoreText(const CampaignRow& row) {
 // (A pixel noise declared 3x or 10x too small never reaches CONVERGED on these runs: its
 // innovations keep re-opening the blocks. Without the velocity-error states: 590 of 1172
 // CONVERGED frames beyond 3 sigma.)
-/// The frames of @p spec (measurement level, shipped configuration) whose warnings hold one
-/// that starts with @p prefix.
-std::vector<int> framesWarning(const CampaignRunSpec& spec, const std::string& prefix) {
+/// The frames of @p spec (measurement level, the shipped configuration unless @p config) whose
+/// warnings hold one that starts with @p prefix.
+std::vector<int> framesWarning(const CampaignRunSpec& spec, const std::string& prefix,
+                               const FilterConfig& config = FilterConfig()) {
   std::vector<int> frames;
-  for (const ScenarioFrameResult& f : runMeasurementScenario(spec.scenario, FilterConfig())) {
+  for (const ScenarioFrameResult& f : runMeasurementScenario(spec.scenario, config)) {
     for (const std::string& warning : f.warnings) {
       if (warning.rfind(prefix, 0) == 0) frames.push_back(f.frame);
     }
@@ -630,6 +633,60 @@ TEST(Campaign, AStallWithEveryTrackedPointUnmeasurableIsWarnedOnce) {
   const CampaignRunSpec phase0 = shippedRun(92);
   ASSERT_TRUE(phase0.error.empty()) << phase0.error;
   EXPECT_TRUE(framesWarning(phase0, prefix).empty());
+}
+
+// Lines tilted off x_camr's may be tilted by its rotation or by its baseline's direction, so
+// the epipolar re-opening can widen both (epipolar_knock_baseline_direction): the translation
+// across the baseline, not its length.
+TEST(Campaign, ReopeningTheRightCameraWidensItsTranslationAcrossTheBaselineOnly) {
+  const CampaignRunSpec spec = shippedRun(92);
+  ASSERT_TRUE(spec.error.empty()) << spec.error;
+  MeasurementSimulator simulator(spec.scenario);
+  StereoCalibrationEstimator estimator(FilterConfig(), spec.scenario.left, spec.scenario.right,
+                                       simulator.initialGuess());
+  using namespace layout;
+  const Eigen::Vector3d before =
+      estimator.filter().covariance().diagonal().segment<3>(kCamr + kTranslation);
+  const Eigen::Vector3d baseline =
+      estimator.filter().extrinsics().T_caml_camr.translation().normalized();
+  const double across = 0.5;  // m, wider than the start's 0.1 m
+  estimator.reopenRightCameraRotation(0.1, across);
+  const Matrix12d after = estimator.filter().covariance();
+  for (int axis = 0; axis < 3; ++axis) {
+    const double expected =
+        std::max(before(axis), across * across * (1.0 - std::pow(baseline(axis), 2)));
+    EXPECT_NEAR(after(kCamr + kTranslation + axis, kCamr + kTranslation + axis), expected,
+                1e-9 * expected)
+        << "axis " << axis;
+    EXPECT_NEAR(after(kCamr + kRotation + axis, kCamr + kRotation + axis), 0.01, 1e-12);
+  }
+  // The baseline runs along y (yr): its length's variance is the start's.
+  EXPECT_GT(std::abs(baseline.y()), 0.99);
+  EXPECT_EQ(after(kCamr + kTranslation + 1, kCamr + kTranslation + 1), before(1));
+}
+
+// The same run: at frame 10 its baseline's direction is 5 deg off (xr 2.3 sigma) while x_camr's
+// rotation is 0.2-0.4 deg off, and the test against the rotation's covariance alone (the
+// default) takes the tilted epipolar lines for a knock, then stalls (above) with 164 frames
+// beyond 5 sigma. With the baseline direction's spread in the test's covariance
+// (epipolar_knock_baseline_direction) there is no re-opening but the real knock's.
+TEST(Campaign, AStartsUncertainBaselineDirectionIsNotTakenForAKnockWhenAllowedFor) {
+  const CampaignRunSpec drawn = shippedRun(92, "", 600, /*drawn_phase=*/true);
+  ASSERT_TRUE(drawn.error.empty()) << drawn.error;
+  ASSERT_EQ(settingOf(drawn.settings, "event_frame"), "280");
+  const std::string prefix = "the stereo pairs left x_camr's epipolar lines";
+  FilterConfig allowed_for;
+  allowed_for.epipolar_knock_baseline_direction = 1;
+  const std::vector<int> shipped = framesWarning(drawn, prefix);
+  ASSERT_FALSE(shipped.empty());
+  EXPECT_EQ(shipped.front(), 10);
+  // Its one re-opening is the knock's, at its first pair (0.15 deg at frame 280).
+  EXPECT_EQ(framesWarning(drawn, prefix, allowed_for), std::vector<int>{280});
+  const CampaignRow row =
+      runShipped(drawn, [](FilterConfig* c) { c->epipolar_knock_baseline_direction = 1; });
+  ASSERT_TRUE(row.ok()) << row.status;
+  EXPECT_EQ(row.score.frames_beyond_5sigma, 0) << scoreText(row);  // measured: 0 (164 shipped)
+  EXPECT_TRUE(row.honest()) << scoreText(row);                     // measured: 1.000
 }
 
 TEST(Campaign, TheConvergedStateIsReachedAndNotConfidentlyWrong) {

@@ -142,6 +142,10 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "x_camr's epipolar lines (a knocked right camera; epipolar_consistency.h); 0 = off"),
       integer("epipolar_knock_pairs", &C::epipolar_knock_pairs, 1, 1000,
               "image pairs in a row beyond that bound before x_camr's rotation is re-opened"),
+      integer("epipolar_knock_baseline_direction", &C::epipolar_knock_baseline_direction, 0, 1,
+              "1: that test allows for the baseline direction's spread and a knock re-opens "
+              "the translation across the baseline too, 0: the rotation's alone (measured "
+              "mixed: docs/RESULTS.md Session 35)"),
       integer("relinearization_frames", &C::relinearization_frames, 0, 100000,
               "frames between checks whether the estimate left its start (linearisation) "
               "point; 0 = never restart"),

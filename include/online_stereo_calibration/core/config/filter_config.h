@@ -163,6 +163,15 @@ struct FilterConfig {
   /// kept, instead of re-opening was worse: yaw_r, which one pair hardly shows, then locked
   /// 12-14 sigma off after real knocks (runs 62, 139).
   int epipolar_knock_pairs = 1;
+  /// 1: the epipolar knock test allows for the spread of x_camr's baseline direction too (it
+  /// also tilts the lines; epipolar_consistency.h), and a knock it finds re-opens x_camr's
+  /// translation across the baseline with the rotation (to the baseline's length times the
+  /// rotation's re-opening). 0: the rotation's covariance alone, the translation kept.
+  /// Off by default: it ends default campaign run 92's false knock (a start's baseline 5 deg
+  /// off taken for one: 164 frames beyond 5 sigma -> 0), but at image level it also hides
+  /// start alarms whose stereo-fit re-seed helped (image run 15: 0 -> 94 frames); measured
+  /// mixed over five benches (docs/RESULTS.md "Session 35").
+  int epipolar_knock_baseline_direction = 0;
 
   // --- re-linearisation after a start or a re-opening (issue 14) ---
   /// Every this many frames after a start (or a re-opened block), the estimator compares the

@@ -117,9 +117,12 @@ class StereoCalibrationEstimator {
   /// Forgets every tracked point (e.g. time jumped back); the calibration is kept.
   std::vector<PointId> resetTracking();
   /// The right camera was knocked (CalibrationPipeline): x_camr's rotation uncertainty is
-  /// re-opened to at least `rotation_sigma` (rad; its translation kept: a knock turns a
-  /// camera) and every point is forgotten. Returns the forgotten points.
-  std::vector<PointId> reopenRightCameraRotation(double rotation_sigma);
+  /// re-opened to at least `rotation_sigma` (rad) and every point is forgotten. Its translation
+  /// is kept (a knock turns a camera), widened to at least `across_baseline_sigma` (m) across
+  /// the baseline only: epipolar lines tilted by the rotation could also be tilted by the
+  /// baseline's direction. Returns the forgotten points.
+  std::vector<PointId> reopenRightCameraRotation(double rotation_sigma,
+                                                 double across_baseline_sigma = 0.0);
   /// x_camr re-seeded from a whole-image stereo fit (CalibrationPipeline at a start or after
   /// a re-opening, FilterConfig::stereo_fit_start): its mean becomes @p T_caml_camr and its tangent
   /// covariance block @p covariance (m, rad; [dt, dtheta] as the filter's), uncorrelated with
