@@ -128,9 +128,6 @@ EpipolarEvidence testEpipolarLines(const std::vector<PointMeasurement>& pairs,
   }
   const Eigen::Vector3d b = score.tail<3>();
   const Eigen::Matrix3d H = information.bottomRightCorner<3, 3>();
-  const Eigen::Matrix<double, 3, 5> M = information.bottomRows<3>();
-  const DirectionsMatrix P = directions.transpose() * camr_covariance * directions;
-  const Eigen::Matrix3d C = H + M * P * M.transpose();
   // Scored over the rotations U that the test against the rotation's covariance alone keeps
   // (the eigenvectors of S = H + H P_theta H above kRelativeRank of the largest): with or
   // without the baseline direction the same degrees of freedom and bound.
@@ -156,6 +153,9 @@ EpipolarEvidence testEpipolarLines(const std::vector<PointMeasurement>& pairs,
   if (!with_baseline_direction) {
     evidence.statistic = rotation_alone;
   } else {
+    const Eigen::Matrix<double, 3, 5> M = information.bottomRows<3>();
+    const DirectionsMatrix P = directions.transpose() * camr_covariance * directions;
+    const Eigen::Matrix3d C = H + M * P * M.transpose();
     const Eigen::MatrixXd basis = U.leftCols(evidence.dof);
     const Eigen::VectorXd projected = basis.transpose() * b;
     const Eigen::MatrixXd projected_covariance = basis.transpose() * C * basis;
