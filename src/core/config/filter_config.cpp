@@ -98,6 +98,9 @@ const std::vector<ParameterSpec>& filterParameterTable() {
       integer("max_points", &C::max_points, 1, 100000, "points kept in the filter state"),
       integer("inverse_depth_points", &C::inverse_depth_points, 0, 1,
               "1: points as inverse depth (x/z, y/z, 1/z), 0: as positions (the seed's)"),
+      integer("keep_points_in_front", &C::keep_points_in_front, 0, 1,
+              "1: an inverse-depth point beyond infinity (negative inverse depth) is moved to "
+              "the farthest depth, covariance kept (measured mixed: docs/RESULTS.md Session 36)"),
       integer("baseline_scaled_points", &C::baseline_scaled_points, 0, 1,
               "1: points in units of the baseline (what stereo measures), 0: metric (the seed's)"),
       integer("errors_in_variables_compensation", &C::errors_in_variables_compensation, 0, 1,

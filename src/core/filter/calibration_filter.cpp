@@ -749,6 +749,7 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
     TrackedPoint& point = points_[inn->point];
     const Eigen::Matrix<double, 3, 4> K = point.D * inn->H_p.transpose() * inn->S0.inverse();
     point.mean += K * inn->residual + (point.B - K * inn->J) * dg;
+    keepInFront(&point);
     point.B -= K * inn->J;
     point.updated = true;
     const Eigen::Matrix3d IKH = Eigen::Matrix3d::Identity() - K * inn->H_p;
@@ -1213,6 +1214,7 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
   TrackedPoint point;
   point.id = m.id;
   point.mean = ut.mean.head<3>();
+  keepInFront(&point);
   point.B = MatrixXd::Zero(3, persistentDim());
   point.B.middleCols<6>(layout::kCamr) = ut.jacobian.topLeftCorner<3, 6>();
   // D = Cov(p) - B P B^T: what the calibration does not explain (pixel noise, nonlinearity).
@@ -1222,6 +1224,12 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
   index_[point.id] = points_.size();
   points_.push_back(std::move(point));
   return true;
+}
+
+void CalibrationFilter::keepInFront(TrackedPoint* point) const {
+  // (Positions: a new one's depth is checked, addPoint.)
+  if (config_.keep_points_in_front == 0 || !coordinates_.inverseDepth()) return;
+  point->mean.z() = std::max(point->mean.z(), minInverseDepth() * pointScale());
 }
 
 void CalibrationFilter::removePoint(PointId id) {

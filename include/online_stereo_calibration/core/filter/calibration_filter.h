@@ -197,6 +197,12 @@ class CalibrationFilter {
   /// The inverse depth (1/m) below which a point is placed, where a position is needed (its
   /// process noise, points()): half that of the farthest new point.
   double minInverseDepth() const { return 0.5 / config_.max_point_depth; }
+  /// With FilterConfig::keep_points_in_front: moves an inverse-depth point's mean that lies
+  /// beyond infinity (a negative inverse depth) or farther than 2 max_point_depth to that depth
+  /// (minInverseDepth); its covariance is kept. Such a mean is in front of the camera within
+  /// its uncertainty, but linearised there the motion's parallax points the wrong way. At the
+  /// farthest depth it tells the camera's rotation only, until its parallax tells its depth.
+  void keepInFront(TrackedPoint* point) const;
   /// The length a stored point is measured in (FilterConfig::baseline_scaled_points): the
   /// baseline |t_r| of @p T_caml_camr, or 1 (metres) for metric points.
   double pointScale(const Eigen::Isometry3d& T_caml_camr) const {
