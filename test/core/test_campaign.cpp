@@ -646,22 +646,17 @@ TEST(Campaign, AStallWithEveryTrackedPointUnmeasurableIsWarnedOnce) {
 std::vector<double> run90StartYawL(const FilterConfig& config, int* first_new_points) {
   const CampaignRunSpec spec = shippedRun(90, "", 600, /*drawn_phase=*/true);
   if (!spec.error.empty()) return {};
-  MeasurementSimulator simulator(spec.scenario);
-  StereoCalibrationEstimator estimator(config, spec.scenario.left, spec.scenario.right,
-                                       simulator.initialGuess());
+  // As the campaign runs it: the estimator assumes its configured pixel noise.
+  const std::vector<ScenarioFrameResult> frames =
+      runMeasurementScenario(spec.scenario, config, {}, /*declare_config_pixel_noise=*/true);
+  if (frames.size() < 4) return {};
+  *first_new_points = frames[0].new_points;
   constexpr int kYawL = 5;
   std::vector<double> z;
-  SimulatedFrame frame;
-  for (int f = 0; f < 4 && simulator.nextFrame(&frame); ++f) {
-    for (StereoObservation& o : frame.observations) o.sigma_left = o.sigma_right = 0.0;
-    const FrameReport report = estimator.processFrame(frame.measured_motion, frame.observations);
-    simulator.dropTracks(report.dropped);
-    simulator.setOdometryTimeShift(estimator.odometryTimeShift());
-    if (f == 0) *first_new_points = report.new_points;
-    const CalibrationEstimate estimate = estimator.estimate();
+  for (int f = 0; f < 4; ++f) {
     const double error =
-        std::remainder(estimate.parameters(kYawL) - frame.truth.toParameters()(kYawL), 2.0 * M_PI);
-    z.push_back(std::abs(error) / estimate.sigmas()(kYawL));
+        std::remainder(frames[f].parameters(kYawL) - frames[f].truth(kYawL), 2.0 * M_PI);
+    z.push_back(std::abs(error) / frames[f].sigmas(kYawL));
   }
   return z;
 }
