@@ -531,6 +531,60 @@ TEST(CalibrationFilter, NewFarInverseDepthPointUnderAWideRightCameraPriorMatches
   EXPECT_LT((joint.block<3, 6>(12, 6) - sampled.cross).norm(), 0.1 * sampled.cross.norm());
 }
 
+/// The calibration's errors [x_caml, x_camr] from @p reference, in @p sigma units.
+Vector12d calibrationDifference(const CalibrationFilter& filter,
+                                const CalibrationFilter& reference) {
+  Vector12d d;
+  d.head<6>() = boxMinus(filter.extrinsics().T_veh_caml, reference.extrinsics().T_veh_caml);
+  d.tail<6>() = boxMinus(filter.extrinsics().T_caml_camr, reference.extrinsics().T_caml_camr);
+  return d.cwiseQuotient(reference.covariance().diagonal().cwiseSqrt());
+}
+
+// A point 1000 m ahead (0.18 px of disparity on the 0.3 m rig) is triangulated at ~35 m under
+// an x_camr yaw guess 0.5 deg (5 px) off; the first update turns the yaw back and takes the
+// point beyond 2 max_point_depth. Held out from then on (hold_out_points_beyond_infinity) it
+// updates itself but leaves the calibration as the near points alone would; shipped, it moves it.
+TEST(CalibrationFilter, APointBeyondInfinityHeldOutUpdatesItselfButNotTheCalibration) {
+  SmallProblem problem(0, 3);
+  problem.world = {Eigen::Vector3d(1000.0, 0.0, 1.3), Eigen::Vector3d(12.0, 1.0, 1.0),
+                   Eigen::Vector3d(10.0, -2.0, 1.8)};
+  StereoExtrinsics start = problem.truth;
+  Vector12d p = start.toParameters();
+  p(11) += 0.5 * kDeg;  // the far point's rays cross at ~35 m
+  start = StereoExtrinsics::fromParameters(p);
+  const auto filterAfterTwoSteps = [&](int hold_out, bool with_far_point, StepReport* report) {
+    FilterConfig config;
+    config.hold_out_points_beyond_infinity = hold_out;
+    config.max_sigma_shrink_per_update = 0.0;  // no tempering: one point's effect in full
+    CalibrationFilter filter(config, problem.K);
+    Matrix12d prior = guessCovariance();
+    prior.bottomRightCorner<3, 3>() *= 9.0;  // 0.9 deg
+    filter.reset(start, prior);
+    std::mt19937_64 rng_state = problem.rng;
+    for (const PointMeasurement& m : problem.measure(0, 0.3)) EXPECT_TRUE(filter.addPoint(m));
+    const StepReport first = filter.step(problem.motion(1), problem.measure(1, 0.3));
+    EXPECT_EQ(first.held_out_points, 0);
+    std::vector<PointMeasurement> next = problem.measure(2, 0.3);
+    problem.rng = rng_state;
+    if (!with_far_point) next.erase(next.begin());
+    *report = filter.step(problem.motion(2), next);
+    return filter;
+  };
+  StepReport held, near_only, shipped;
+  const CalibrationFilter held_out = filterAfterTwoSteps(1, true, &held);
+  const CalibrationFilter reference = filterAfterTwoSteps(1, false, &near_only);
+  const CalibrationFilter informed = filterAfterTwoSteps(0, true, &shipped);
+  ASSERT_TRUE(held.accepted && near_only.accepted && shipped.accepted);
+  EXPECT_EQ(held.held_out_points, 1);
+  EXPECT_EQ(held.measurements_used, 3);  // gated in, and updated given the calibration
+  EXPECT_EQ(near_only.held_out_points, 0);
+  EXPECT_EQ(shipped.held_out_points, 0);
+  EXPECT_EQ(held_out.pointCount(), 3u);
+  EXPECT_LT(calibrationDifference(held_out, reference).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_TRUE(held_out.covariance().isApprox(reference.covariance(), 1e-9));
+  EXPECT_GT(calibrationDifference(informed, reference).cwiseAbs().maxCoeff(), 0.05);
+}
+
 /// A filter converged at the truth whose left camera then turns 5 deg about the vehicle's
 /// vertical between frames 3 and 4 (a yaw step of its mounting).
 StepReport stepAcrossALeftCameraYawStep(SmallProblem* problem, CalibrationFilter* filter,

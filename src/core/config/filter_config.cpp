@@ -101,6 +101,9 @@ const std::vector<ParameterSpec>& filterParameterTable() {
       integer("keep_points_in_front", &C::keep_points_in_front, 0, 1,
               "1: an inverse-depth point beyond infinity (negative inverse depth) is moved to "
               "the farthest depth, covariance kept (measured mixed: docs/RESULTS.md Session 36)"),
+      integer("hold_out_points_beyond_infinity", &C::hold_out_points_beyond_infinity, 0, 1,
+              "1: an inverse-depth point beyond infinity updates itself but not the "
+              "calibration until it is back in front (docs/RESULTS.md Session 38)"),
       integer("baseline_scaled_points", &C::baseline_scaled_points, 0, 1,
               "1: points in units of the baseline (what stereo measures), 0: metric (the seed's)"),
       integer("errors_in_variables_compensation", &C::errors_in_variables_compensation, 0, 1,

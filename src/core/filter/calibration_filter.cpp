@@ -677,9 +677,16 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   double nis_sum = 0.0;
   // From a start or a re-opening far from the truth one update may not shrink a
   // calibration sigma by more than max_sigma_shrink_per_update (update_tempering.h).
+  // A point held out (informsCalibration) updates itself below, given dg, but not dg.
+  std::vector<const PointInnovation*> informing;
+  informing.reserve(used.size());
+  for (const PointInnovation* inn : used) {
+    if (informsCalibration(points_[inn->point])) informing.push_back(inn);
+  }
+  report.held_out_points = static_cast<int>(used.size() - informing.size());
   std::vector<LinearizedMeasurement> linearized;
-  linearized.reserve(used.size());
-  for (const PointInnovation* inn : used) linearized.push_back({&inn->J, &inn->S0});
+  linearized.reserve(informing.size());
+  for (const PointInnovation* inn : informing) linearized.push_back({&inn->J, &inn->S0});
   // ... nor, after a start or re-opening, below its floor before enough points were
   // measured (gated out or not: it is the amount of data that is thin, not its agreement).
   const bool floored = (thin_evidence_floor_.array() > 0.0).any();
@@ -705,15 +712,15 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   // the calibration drifts. Fed to the consistency monitor they raised x_camr's process
   // noise for tens of seconds (x_camr RMSE +15-30 % over the default campaign).
   const bool monitored =
-      final_pass && config_.consistency_window > 0.0 && !used.empty() && tempering == 1.0;
+      final_pass && config_.consistency_window > 0.0 && !informing.empty() && tempering == 1.0;
   const VectorXd dg_prior = dg;
   MatrixXd information = monitored ? MatrixXd::Zero(G, G) : MatrixXd();
   VectorXd score = monitored ? VectorXd::Zero(G) : VectorXd();
   double residual_norm = 0.0;
   MatrixXd PJt, gain;
   VectorXd eiv_score = VectorXd::Zero(G);
-  for (size_t k = 0; k < used.size(); ++k) {
-    const PointInnovation* inn = used[k];
+  for (size_t k = 0; k < informing.size(); ++k) {
+    const PointInnovation* inn = informing[k];
     // A point whose S is indefinite is skipped here; its own update below uses S0 only.
     if (!sequentialGain(P, linearized[k], tempering, &PJt, &gain)) continue;
     dg += gain * (inn->residual - inn->J * dg);
@@ -736,7 +743,7 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   if (!eiv_score.isZero()) dg.noalias() += P * eiv_score / tempering;
   if (monitored) {
     scores_ = computeUpdateScores(information, score, residual_norm, P,
-                                  layout::kMeasurementDim * static_cast<int>(used.size()));
+                                  layout::kMeasurementDim * static_cast<int>(informing.size()));
     has_scores_ = true;
   }
   *motion_error = shared ? Vector6d(dg.tail<6>()) : Vector6d::Zero();
@@ -1224,6 +1231,11 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
   index_[point.id] = points_.size();
   points_.push_back(std::move(point));
   return true;
+}
+
+bool CalibrationFilter::informsCalibration(const TrackedPoint& point) const {
+  if (config_.hold_out_points_beyond_infinity == 0 || !coordinates_.inverseDepth()) return true;
+  return point.mean.z() >= minInverseDepth() * pointScale();
 }
 
 void CalibrationFilter::keepInFront(TrackedPoint* point) const {

@@ -91,6 +91,16 @@ struct FilterConfig {
   /// paper_offroad unchanged, but the 11 cm rig guessed at 1 cm (Start.ABaselineGuessFarTooShort
   /// IsMeasuredFromMotion) 0.78 instead of >= 0.95 of its frames within 3 sigma.
   int keep_points_in_front = 0;
+  /// 1: an inverse-depth point beyond infinity or farther than 2 max_point_depth (its mean's
+  /// inverse depth below minInverseDepth: a wrong x_camr rotation guess shifted its disparity
+  /// past zero) informs only itself, not the calibration (a Schmidt "consider" point): it is
+  /// gated, counted in the jump test and updated given the calibration's correction, but its
+  /// innovation does not move the calibration, the tempering or the consistency monitor
+  /// until its mean is back in front. Linearised beyond infinity its parallax points the wrong
+  /// way (default campaign run 90: yaw_l 6.9 sigma off after four such points); moving it to
+  /// the farthest depth (keep_points_in_front) instead distorts what it says about x_camr.
+  /// 0: every gated point informs the calibration. Measured in docs/RESULTS.md "Session 38".
+  int hold_out_points_beyond_infinity = 0;
   /// 1: points are stored in units of the baseline (the left-to-right camera distance |t_r|):
   /// a point p is kept as p / |t_r|, which is what a stereo pair measures. Two images of a
   /// static scene then say nothing about the baseline, exactly and at any linearisation

@@ -73,9 +73,11 @@ inline Vector6d uniformBlockSigmas(double translation_sigma, double rotation_sig
 
 /// What one filter step did.
 struct StepReport {
-  bool accepted = false;              ///< false: the input was rejected and nothing changed
-  std::string message;                ///< why it was rejected, or notes
-  int measurements_used = 0;          ///< points that updated the filter
+  bool accepted = false;      ///< false: the input was rejected and nothing changed
+  std::string message;        ///< why it was rejected, or notes
+  int measurements_used = 0;  ///< points that updated the filter
+  /// Of those, points that updated only themselves (FilterConfig::hold_out_points_beyond_infinity)
+  int held_out_points = 0;
   int invalid_measurements = 0;       ///< non-finite or non-positive-variance measurements ignored
   std::vector<PointId> outliers;      ///< gated out (Mahalanobis) and removed
   std::vector<PointId> lost;          ///< not measured (or unpredictable) and removed
@@ -203,6 +205,9 @@ class CalibrationFilter {
   /// its uncertainty, but linearised there the motion's parallax points the wrong way. At the
   /// farthest depth it tells the camera's rotation only, until its parallax tells its depth.
   void keepInFront(TrackedPoint* point) const;
+  /// False for a point held out by FilterConfig::hold_out_points_beyond_infinity: an
+  /// inverse-depth mean beyond infinity or farther than 2 max_point_depth (minInverseDepth).
+  bool informsCalibration(const TrackedPoint& point) const;
   /// The length a stored point is measured in (FilterConfig::baseline_scaled_points): the
   /// baseline |t_r| of @p T_caml_camr, or 1 (metres) for metric points.
   double pointScale(const Eigen::Isometry3d& T_caml_camr) const {
