@@ -189,6 +189,11 @@ const std::vector<ParameterSpec>& filterParameterTable() {
               "while no point can be initialised (a baseline guess far off), measure the "
               "baseline's length from the left camera's motion at the odometry's scale and "
               "restart x_camr's translation from it; 0 = off"),
+      integer("disparity_offset_turn", &C::disparity_offset_turn, 0, 1,
+              "1: while no point can be initialised and the baseline's length is known, turn "
+              "x_camr by the disparity offset measured from the left camera's motion"),
+      real("max_disparity_offset_turn_deg", &C::max_disparity_offset_turn, kDeg, 0.0, 90.0,
+           "the largest turn disparity_offset_turn makes"),
       real("initial_time_offset_ms", &C::initial_time_offset, 1e-3, -1000.0, 1000.0,
            "prior mean of the camera clock minus the odometry clock (the odometry's sample "
            "stamped t holds the vehicle at camera time t + offset; a late-stamping odometry "

@@ -494,10 +494,21 @@ bool StereoCalibrationEstimator::learnBaselineLength(
   // no point passes the depth check. With a length it knows, the points are kept out by
   // something else (x_caml or x_camr's rotation far off; default campaign run 90), which a
   // restart of x_camr from the current estimate would lock in.
-  if (!(old_sigma > kUnknownLengthShare * old_length) || !(sigma < 0.5 * old_sigma)) return false;
-  // The length along the baseline's direction; across it the direction's uncertainty at the
-  // new length; the rotation's covariance kept.
-  const double ratio = length.length / old_length;
+  const bool offset_significant = std::abs(length.offset) > 3.0 * length.offset_sigma;
+  if (!(old_sigma > kUnknownLengthShare * old_length) || !(sigma < 0.5 * old_sigma)) {
+    // The length known, the rotation keeps the pairs out (FilterConfig::disparity_offset_turn).
+    if (config_.disparity_offset_turn == 0 || !offset_significant ||
+        !(std::abs(length.offset) <= config_.max_disparity_offset_turn))
+      return false;
+    return turnRightCameraByDisparityOffset(length, report);
+  }
+  // The length along the baseline's direction; across it the translation's covariance as it
+  // was, in metres: the length says nothing about it. (Scaled with the length, as a direction
+  // uncertainty, it grew tenfold for an 11 cm rig guessed at 1 cm: 1.1 m across a 0.11 m
+  // baseline, which no linearisation follows; one of 16 seeds of that start locked in the
+  // baseline's direction 75 deg off, xr 14 sigma, and three more ended not honest:
+  // docs/RESULTS.md "Session 38".) Only a shorter length scales it down with the baseline.
+  const double ratio = std::min(1.0, length.length / old_length);
   const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - c * c.transpose();
   Matrix6d block = P.block<6, 6>(kCamr, kCamr);
   block.topLeftCorner<3, 3>() = ratio * ratio * across * block.topLeftCorner<3, 3>() * across +
@@ -529,6 +540,26 @@ bool StereoCalibrationEstimator::learnBaselineLength(
           << (turned ? ": x_camr turned by it about the axis across the baseline and the view"
                      : "");
   message << "; tracks reset";
+  report->warnings.push_back(message.str());
+  return true;
+}
+
+bool StereoCalibrationEstimator::turnRightCameraByDisparityOffset(const BaselineLength& length,
+                                                                  FrameReport* report) {
+  const Eigen::Matrix3d& R_bo = rotationBodyOptical();
+  const Eigen::Isometry3d T_lopt_ropt =
+      withoutDisparityOffset(filter_.extrinsics().leftToRightOptical(), length.offset);
+  Eigen::Isometry3d T_caml_camr = filter_.extrinsics().T_caml_camr;
+  T_caml_camr.linear() = R_bo * T_lopt_ropt.linear() * R_bo.transpose();
+  const Matrix6d block = filter_.covariance().block<6, 6>(layout::kCamr, layout::kCamr);
+  for (PointId id : reseedRightCamera(T_caml_camr, block, true)) report->dropped.push_back(id);
+  std::ostringstream message;
+  message.precision(3);
+  message << "disparity offset from motion: x_camr turned by " << length.offset * 180.0 / M_PI
+          << " deg (1 sigma " << length.offset_sigma * 180.0 / M_PI
+          << " deg) about the axis across the baseline and the view, its length kept ("
+          << length.length << " m measured, 1 sigma " << length.sigma << " m; " << length.inliers
+          << " points in " << length.pairs << " pairs of the left camera's motion); tracks reset";
   report->warnings.push_back(message.str());
   return true;
 }

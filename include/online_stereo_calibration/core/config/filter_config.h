@@ -261,6 +261,17 @@ struct FilterConfig {
   /// odometry's scale (baseline_from_motion.h) and restart x_camr's translation from it
   /// (issue 14: "a guess 50 % off must converge"). 0 = off (the paper).
   int baseline_from_motion = 1;
+  /// With baseline_from_motion, while not one point can be initialised and the baseline's
+  /// length is known (its sigma below 30 % of it): x_camr's rotation is
+  /// what keeps the pairs out (yaw_r guessed 4.7 deg off on a 0.26 m rig put every pair beyond
+  /// infinity: no point for 15 s, then yr 16 sigma off; default campaign run 24). 1: x_camr is
+  /// turned by the disparity offset measured with the length (at most
+  /// max_disparity_offset_turn), its covariance kept. 0: wait (the stereo fit or the scene may
+  /// let points in). Measured in docs/RESULTS.md "Session 38".
+  int disparity_offset_turn = 0;
+  /// The largest turn disparity_offset_turn makes: beyond it the disparity model's fit is not
+  /// honest (yaw_r 20 deg off: turned 23.4 deg at 1 sigma 0.08 deg).
+  double max_disparity_offset_turn = 10.0 * 0.0174532925199432958;  ///< rad
 
   // --- the odometry's own errors as states (issue 15; process_model.h correctedMotion) ---
   /// Prior mean (s) of the camera-odometry time offset d: the camera clock minus the

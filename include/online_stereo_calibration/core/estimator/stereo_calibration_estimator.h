@@ -131,6 +131,9 @@ class StereoCalibrationEstimator {
   /// forgotten and the odometry states (the time offset) start from their priors. Re-linearised
   /// (relinearizeIfMoved) as after a start if @p start, else as after a re-opening of x_camr.
   /// Returns the forgotten points.
+  /// x_camr turned by the disparity offset @p length measured from the left camera's motion
+  /// (the length known, the rotation what keeps every point out), covariance kept.
+  bool turnRightCameraByDisparityOffset(const BaselineLength& length, FrameReport* report);
   std::vector<PointId> reseedRightCamera(const Eigen::Isometry3d& T_caml_camr,
                                          const Matrix6d& covariance, bool start);
   /// Starts over from a new guess with the config's initial uncertainty.
