@@ -3,6 +3,7 @@
 //
 //   calibrate_simulation [--scenario paper_offroad|urban_planar|drift] [--config PARAMS.yaml]
 //                        [--out DIR] [--frames N] [--seed N] [--window FIRST LAST]
+//                        [--baseline M] [--baseline-guess M]
 //
 // (the image-level counterpart, from rendered images through the front end, is `simulate` +
 // `evaluate`, which scripts/demo.sh runs).
@@ -21,6 +22,7 @@
 
 #include "online_stereo_calibration/core/sim/scenario_runner.h"
 #include "online_stereo_calibration/tools/calibration_file.h"
+#include "online_stereo_calibration/tools/campaign_score.h"
 #include "online_stereo_calibration/tools/command_line.h"
 #include "online_stereo_calibration/tools/estimates_csv.h"
 #include "online_stereo_calibration/tools/evaluation.h"
@@ -36,6 +38,7 @@ struct Options {
   int frames = -1;
   int seed = -1;
   int window_first = 1000, window_last = 1150;
+  double baseline = -1.0, baseline_guess = -1.0;  // m; negative: the scenario's
 };
 
 /// The command line (`--help` prints it).
@@ -57,6 +60,13 @@ osc::CommandLine commandLine(Options* o) {
   cli.option("--window", &o->window_first, &o->window_last, "FIRST LAST",
              "frames of the Table I RMSE (clipped to the drive)")
       .range(0, 1e7);
+  cli.option("--baseline", &o->baseline, "M",
+             "the rig's true baseline length along y (-1: the scenario's)")
+      .range(-1.0, 10.0);
+  cli.option("--baseline-guess", &o->baseline_guess, "M",
+             "the initial guess of that length, its prior unchanged (-1: the scenario's start "
+             "error)")
+      .range(-1.0, 10.0);
   return cli;
 }
 
@@ -84,6 +94,12 @@ int main(int argc, char** argv) {
         osc::MeasurementScenario scenario = scenarioByName(options.scenario);
         if (options.frames > 0) scenario.frames = options.frames;
         if (options.seed >= 0) scenario.seed = static_cast<unsigned>(options.seed);
+        constexpr int kYr = 7;  // the right camera sits at -baseline along the left's y
+        const double guess_yr = scenario.truth(kYr) + scenario.initial_error(kYr);
+        if (options.baseline > 0.0) scenario.truth(kYr) = -options.baseline;
+        scenario.initial_error(kYr) =
+            (options.baseline_guess > 0.0 ? -options.baseline_guess : guess_yr) -
+            scenario.truth(kYr);
         const osc::FilterConfig config = options.config.empty()
                                              ? osc::FilterConfig()
                                              : osc::readFilterConfigFile(options.config);
@@ -94,6 +110,7 @@ int main(int argc, char** argv) {
         std::vector<osc::EstimateRow> estimate_rows;
         std::vector<osc::ReferenceRow> reference_rows;
         std::vector<double> times;
+        std::vector<osc::ScenarioFrameResult> results;
         int jumps = 0;
         const auto start = std::chrono::steady_clock::now();
         std::cerr << "calibrating simulated drive '" << scenario.name << "': " << scenario.frames
@@ -105,6 +122,7 @@ int main(int argc, char** argv) {
           reference_rows.push_back(osc::referenceRowOf(r));
           reference.write(reference_rows.back());
           times.push_back(r.time_ms);
+          results.push_back(r);
           if (r.jump_detected) {
             ++jumps;
             std::cerr << "  frame " << r.frame
@@ -143,6 +161,14 @@ int main(int argc, char** argv) {
           text << "Step of x_caml at frame " << scenario.step_frame
                << ": yaw_l within 0.3 deg from frame " << back << " on ("
                << (back >= 0 ? back - scenario.step_frame : -1) << " frames)\n";
+        }
+        if (scenario.frames > osc::kCampaignFirstScoredFrame) {
+          const osc::CampaignScore honesty = osc::scoreCampaignRun(results);
+          text << "Honesty from frame " << osc::kCampaignFirstScoredFrame
+               << ": all 12 errors within 3 sigma in " << honesty.share_within_3sigma
+               << " of the frames (>= 0.95 honest), " << honesty.frames_beyond_5sigma
+               << " frames beyond 5 sigma, largest |error| / sigma " << honesty.max_z << " ("
+               << honesty.max_z_parameter << ")\n";
         }
         text << "Sudden changes detected: " << jumps << "\n"
              << "Estimator time per frame: median " << median << " ms, p95 " << p95 << " ms\n";
