@@ -95,11 +95,10 @@ int main(int argc, char** argv) {
         if (options.frames > 0) scenario.frames = options.frames;
         if (options.seed >= 0) scenario.seed = static_cast<unsigned>(options.seed);
         constexpr int kYr = 7;  // the right camera sits at -baseline along the left's y
-        const double guess_yr = scenario.truth(kYr) + scenario.initial_error(kYr);
-        if (options.baseline > 0.0) scenario.truth(kYr) = -options.baseline;
-        scenario.initial_error(kYr) =
-            (options.baseline_guess > 0.0 ? -options.baseline_guess : guess_yr) -
-            scenario.truth(kYr);
+        if (options.baseline > 0.0) scenario.truth(kYr) = -options.baseline;  // start error kept
+        if (options.baseline_guess > 0.0) {
+          scenario.initial_error(kYr) = -options.baseline_guess - scenario.truth(kYr);
+        }
         const osc::FilterConfig config = options.config.empty()
                                              ? osc::FilterConfig()
                                              : osc::readFilterConfigFile(options.config);

@@ -531,7 +531,7 @@ TEST(CalibrationFilter, NewFarInverseDepthPointUnderAWideRightCameraPriorMatches
   EXPECT_LT((joint.block<3, 6>(12, 6) - sampled.cross).norm(), 0.1 * sampled.cross.norm());
 }
 
-/// The calibration's errors [x_caml, x_camr] from @p reference, in @p sigma units.
+/// @p filter's calibration [x_caml, x_camr] from @p reference's, in @p reference's sigmas.
 Vector12d calibrationDifference(const CalibrationFilter& filter,
                                 const CalibrationFilter& reference) {
   Vector12d d;

@@ -678,7 +678,7 @@ TEST(Campaign, PointsBeyondInfinityKeptInFrontDoNotTurnTheLeftCameraAwayOnAStart
 }
 
 // Held out of the calibration's update instead (hold_out_points_beyond_infinity) they do not
-// either, and what they say once back in front is not distorted by a move.
+// either.
 TEST(Campaign, PointsBeyondInfinityHeldOutDoNotTurnTheLeftCameraAwayOnAStartsFirstUpdates) {
   FilterConfig held_out;
   held_out.hold_out_points_beyond_infinity = 1;

@@ -521,13 +521,8 @@ bool StereoCalibrationEstimator::learnBaselineLength(
   // (yaw_r for a horizontal rig; the stereo fit at a start hardly determines it): re-centred
   // when significant, its sigma kept (the filter linearises near the truth, and nothing it
   // did not learn is claimed).
-  const bool turned = std::abs(length.offset) > 3.0 * length.offset_sigma;
-  if (turned) {
-    const Eigen::Matrix3d& R_bo = rotationBodyOptical();
-    const Eigen::Isometry3d T_lopt_ropt =
-        withoutDisparityOffset(filter_.extrinsics().leftToRightOptical(), length.offset);
-    T_caml_camr.linear() = R_bo * T_lopt_ropt.linear() * R_bo.transpose();
-  }
+  const bool turned = offset_significant;
+  if (turned) T_caml_camr.linear() = rightCameraTurnedByDisparityOffset(length.offset).linear();
   for (PointId id : reseedRightCamera(T_caml_camr, block, true)) report->dropped.push_back(id);
   std::ostringstream message;
   message.precision(3);
@@ -544,13 +539,19 @@ bool StereoCalibrationEstimator::learnBaselineLength(
   return true;
 }
 
-bool StereoCalibrationEstimator::turnRightCameraByDisparityOffset(const BaselineLength& length,
-                                                                  FrameReport* report) {
+Eigen::Isometry3d StereoCalibrationEstimator::rightCameraTurnedByDisparityOffset(
+    double offset) const {
   const Eigen::Matrix3d& R_bo = rotationBodyOptical();
   const Eigen::Isometry3d T_lopt_ropt =
-      withoutDisparityOffset(filter_.extrinsics().leftToRightOptical(), length.offset);
+      withoutDisparityOffset(filter_.extrinsics().leftToRightOptical(), offset);
   Eigen::Isometry3d T_caml_camr = filter_.extrinsics().T_caml_camr;
   T_caml_camr.linear() = R_bo * T_lopt_ropt.linear() * R_bo.transpose();
+  return T_caml_camr;
+}
+
+bool StereoCalibrationEstimator::turnRightCameraByDisparityOffset(const BaselineLength& length,
+                                                                  FrameReport* report) {
+  const Eigen::Isometry3d T_caml_camr = rightCameraTurnedByDisparityOffset(length.offset);
   const Matrix6d block = filter_.covariance().block<6, 6>(layout::kCamr, layout::kCamr);
   for (PointId id : reseedRightCamera(T_caml_camr, block, true)) report->dropped.push_back(id);
   std::ostringstream message;

@@ -123,6 +123,12 @@ class StereoCalibrationEstimator {
   /// baseline's direction. Returns the forgotten points.
   std::vector<PointId> reopenRightCameraRotation(double rotation_sigma,
                                                  double across_baseline_sigma = 0.0);
+  /// x_camr turned by the disparity offset @p length measured from the left camera's motion
+  /// (the length known, the rotation what keeps every point out), covariance kept.
+  bool turnRightCameraByDisparityOffset(const BaselineLength& length, FrameReport* report);
+  /// The current x_camr turned about its centre so that the disparity offset @p offset (rad,
+  /// BaselineLength::offset) vanishes (withoutDisparityOffset), in the body frames.
+  Eigen::Isometry3d rightCameraTurnedByDisparityOffset(double offset) const;
   /// x_camr re-seeded from a whole-image stereo fit (CalibrationPipeline at a start or after
   /// a re-opening, FilterConfig::stereo_fit_start): its mean becomes @p T_caml_camr and its tangent
   /// covariance block @p covariance (m, rad; [dt, dtheta] as the filter's), uncorrelated with
@@ -131,9 +137,6 @@ class StereoCalibrationEstimator {
   /// forgotten and the odometry states (the time offset) start from their priors. Re-linearised
   /// (relinearizeIfMoved) as after a start if @p start, else as after a re-opening of x_camr.
   /// Returns the forgotten points.
-  /// x_camr turned by the disparity offset @p length measured from the left camera's motion
-  /// (the length known, the rotation what keeps every point out), covariance kept.
-  bool turnRightCameraByDisparityOffset(const BaselineLength& length, FrameReport* report);
   std::vector<PointId> reseedRightCamera(const Eigen::Isometry3d& T_caml_camr,
                                          const Matrix6d& covariance, bool start);
   /// Starts over from a new guess with the config's initial uncertainty.
