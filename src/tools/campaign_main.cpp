@@ -7,6 +7,7 @@
 // Writes DIR/campaign.csv (one row per run), DIR/summary.txt, DIR/campaign.png, the rows of
 // single runs in DIR/runs/ and the campaign's inputs in DIR/inputs/; --only K replays run K
 // into DIR/run_K/ (estimates.csv, reference.csv, plots, settings.txt).
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -16,6 +17,7 @@
 #include "online_stereo_calibration/tools/campaign_ranges.h"
 #include "online_stereo_calibration/tools/command_line.h"
 #include "online_stereo_calibration/tools/package_files.h"
+#include "online_stereo_calibration/tools/perfect_filter.h"
 
 namespace {
 
@@ -147,6 +149,10 @@ int main(int argc, char** argv) {
           throw osc::CommandLineError("--runs is required (or --only K)");
         }
         const osc::CampaignInputs inputs = loadInputs(parsed);
+        if (!inputs.ranges.dropped_recorded.empty()) {
+          std::cout << "campaign: " << inputs.ranges.dropped_recorded
+                    << " (the recorded trajectories are in the project's ../shared/data)\n";
+        }
         if (parsed.only >= 0) {
           osc::replayCampaignRun(inputs, parsed.out, parsed.only, true, &std::cout);
           return 0;
@@ -158,8 +164,11 @@ int main(int argc, char** argv) {
         const std::vector<osc::CampaignRow> rows = osc::runCampaign(inputs, options);
         int honest = 0;
         for (const osc::CampaignRow& row : rows) honest += row.honest();
-        std::cout << "campaign: " << honest << " of " << rows.size() << " runs honest; wrote "
-                  << parsed.out << "/campaign.csv, summary.txt, campaign.png\n";
+        const osc::PerfectFilterScore perfect = osc::perfectFilterScore(inputs.frames);
+        std::cout << "campaign: " << honest << " of " << rows.size() << " runs honest (a perfect "
+                  << "filter: " << std::lround(100.0 * perfect.honest_low) << "-"
+                  << std::lround(100.0 * perfect.honest_high) << " %); wrote " << parsed.out
+                  << "/campaign.csv, summary.txt, campaign.png\n";
         return 0;
       });
 }

@@ -26,6 +26,7 @@
 #include "online_stereo_calibration/tools/campaign_score.h"
 #include "online_stereo_calibration/tools/campaign_summary.h"
 #include "online_stereo_calibration/tools/estimates_csv.h"
+#include "online_stereo_calibration/tools/perfect_filter.h"
 #include "online_stereo_calibration/tools/tum_trajectory.h"
 
 namespace osc {
@@ -109,9 +110,12 @@ TEST(CampaignRanges, ErrorsNameTheKey) {
             std::string::npos);
   // The default kinds include `recorded`, which needs trajectories_dir.
   EXPECT_NE(parseError("").find("trajectories_dir: not given"), std::string::npos);
-  EXPECT_NE(parseError("trajectories_dir: /nonexistent/dir")
-                .find("trajectories_dir: '/nonexistent/dir' is not a directory"),
+  // ... and a directory that holds them when it is the only kind.
+  const std::string only_recorded =
+      parseError("trajectories_dir: /nonexistent/dir\nmotion: {kind: recorded}");
+  EXPECT_NE(only_recorded.find("trajectories_dir: '/nonexistent/dir' is not a directory"),
             std::string::npos);
+  EXPECT_NE(only_recorded.find("the only kind"), std::string::npos);
   // Every problem at once.
   const std::string both =
       parseError(std::string(kNoRecorded) + "rig: {baseline_m: [0.5, 0.1], focal: 3}");
@@ -124,6 +128,34 @@ TEST(CampaignRanges, ErrorsNameTheKey) {
   EXPECT_EQ(fixed.baseline_m.max, 0.3);
   EXPECT_EQ(fixed.lens.weight("equidistant"), 1.0);
   EXPECT_EQ(fixed.lens.weight("pinhole"), 0.0);
+}
+
+TEST(CampaignRanges, MissingRecordedTrajectoriesDropThatKindAndSaySo) {
+  // A clone without ../shared/data: the shipped ranges still draw the other motions.
+  TempDir empty;
+  for (const std::string& dir : {std::string("/nonexistent/dir"), empty.path()}) {
+    const CampaignRanges ranges = parseCampaignRanges("trajectories_dir: " + dir, "t");
+    EXPECT_EQ(ranges.motion.weight("recorded"), 0.0) << dir;
+    EXPECT_EQ(ranges.motion.weight("offroad"), 1.0) << dir;
+    EXPECT_EQ(ranges.motion.weight("urban"), 1.0) << dir;
+    EXPECT_NE(ranges.dropped_recorded.find("trajectories_dir: '" + dir), std::string::npos)
+        << ranges.dropped_recorded;
+    EXPECT_NE(ranges.dropped_recorded.find("'recorded' dropped"), std::string::npos);
+    CampaignInputs inputs;
+    inputs.ranges = ranges;
+    inputs.frames = 100;
+    for (int run = 0; run < 12; ++run) {
+      const CampaignRunSpec spec = drawCampaignRun(inputs, run);
+      ASSERT_TRUE(spec.error.empty()) << spec.error;
+      EXPECT_NE(settingOf(spec.settings, "motion"), "recorded") << "run " << run;
+    }
+  }
+  // With the trajectories there, nothing is dropped.
+  TempDir with_file;
+  std::ofstream(with_file.path() + "/a.tum") << "# empty\n";
+  const CampaignRanges kept = parseCampaignRanges("trajectories_dir: " + with_file.path(), "t");
+  EXPECT_TRUE(kept.dropped_recorded.empty()) << kept.dropped_recorded;
+  EXPECT_EQ(kept.motion.weight("recorded"), 1.0);
 }
 
 TEST(CampaignRanges, ShippedFileStatesTheBuiltInDefaults) {
@@ -505,6 +537,30 @@ TEST(CampaignSummary, ParameterBiasIsTheRunsMeanSignedErrorWithItsStandardError)
   EXPECT_NE(summary.find("zr +0.00 +- 0.09 "), std::string::npos) << summary;
 }
 
+TEST(PerfectFilter, IsHonestInTheRunsItsStatisticsPredict) {
+  // scripts/honest_by_chance.py over 4000 runs of 600 frames: honest 0.767 (correlation time
+  // 100 frames) to 0.853 (a constant's running mean), beyond 5 sigma at most 0.001, mean share
+  // within 3 sigma 0.968 (12 x 0.27 % beyond 3 sigma per frame). 1000 runs: +-0.014.
+  const PerfectFilterScore long_runs = perfectFilterScore(600, 1000);
+  EXPECT_GT(long_runs.honest_low, 0.72);
+  EXPECT_LT(long_runs.honest_low, 0.81);
+  EXPECT_GT(long_runs.honest_high, 0.81);
+  EXPECT_LT(long_runs.honest_high, 0.90);
+  EXPECT_LT(long_runs.beyond_5sigma, 0.01);
+  EXPECT_NEAR(long_runs.mean_share, 0.968, 0.004);
+  // The same seed, the same figures.
+  const PerfectFilterScore again = perfectFilterScore(600, 1000);
+  EXPECT_EQ(again.honest_low, long_runs.honest_low);
+  EXPECT_EQ(again.honest_high, long_runs.honest_high);
+  EXPECT_THROW(perfectFilterScore(30), std::invalid_argument);
+  // The summary puts it beside the campaign.
+  std::vector<CampaignRow> rows(2);
+  for (CampaignRow& row : rows) row.frames = 200;
+  const std::string summary = formatCampaignSummary(rows, 1);
+  EXPECT_NE(summary.find("A perfect filter"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("on runs of 200 frames: honest in "), std::string::npos) << summary;
+}
+
 TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
   std::vector<CampaignRow> rows;
   const std::vector<std::pair<std::string, std::string>> values = {
@@ -552,6 +608,23 @@ TEST(CampaignSummary, BucketsSplitNumbersInThirdsAndKindsByValue) {
   EXPECT_NE(summary.find("frames_beyond_5sigma 10 (unseen 4)"), std::string::npos) << summary;
   EXPECT_EQ(summary.find("run 4  seed"), std::string::npos) << summary;
 }
+
+/// The directory of the recorded trajectories the shipped ranges draw from (config/campaign.yaml's
+/// trajectories_dir): the project's ../shared/data, not part of a clone.
+const std::string kSharedTrajectories =
+    std::string(OSC_SOURCE_DIR) + "/../shared/data/trajectories";
+
+/// Tests that replay a run drawn from the shipped ranges (or docs/results/campaign's) trace runs
+/// drawn with the recorded trajectories: without them every run's draw changes, so they skip.
+class CampaignRun : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!std::filesystem::is_directory(kSharedTrajectories)) {
+      GTEST_SKIP() << "needs the recorded trajectories of ../shared/data: " << kSharedTrajectories
+                   << " not found";
+    }
+  }
+};
 
 /// Run @p run (of @p frames frames) of the shipped ranges (config/campaign.yaml), with the
 /// events' kinds replaced by @p events when given. An error in the spec if the file's events
@@ -616,7 +689,7 @@ std::vector<int> framesWarning(const CampaignRunSpec& spec, const std::string& p
   return frames;
 }
 
-TEST(Campaign, AStallWithEveryTrackedPointUnmeasurableIsWarnedOnce) {
+TEST_F(CampaignRun, AStallWithEveryTrackedPointUnmeasurableIsWarnedOnce) {
   // Run 92 of the shipped ranges with its drawn steering phase (6.5 deg; docs/RESULTS.md
   // "Session 34"): at frame 10 x_camr's rotation is re-opened to 8.5 deg, and from then on
   // each of the 40 tracked points is dropped as not measurable until frame 92, which the
@@ -635,154 +708,7 @@ TEST(Campaign, AStallWithEveryTrackedPointUnmeasurableIsWarnedOnce) {
   EXPECT_TRUE(framesWarning(phase0, prefix).empty());
 }
 
-// A start whose x_camr rotation is off by more than the pairs' disparities (run 90 drawn: yaw_r
-// 4.5 deg off, 81 px, on a 9.6 cm rig whose points are 3-8 m away, 20 px) triangulates its
-// pairs beyond infinity. Their inverse depths are honest (within their wide sigmas) but
-// negative, and linearised there the motion's parallax points the wrong way: the first updates
-// turn yaw_l from 0.7 to 6.9, 8.9 and 9.6 sigma off in frames 1-3, on 4-13 points. Kept at the
-// farthest depth instead (keep_points_in_front, off by default: docs/RESULTS.md "Session 36")
-// they do not.
-/// yaw_l's |error| / sigma after each of run 90's (drawn) first four pairs.
-std::vector<double> run90StartYawL(const FilterConfig& config, int* first_new_points) {
-  const CampaignRunSpec spec = shippedRun(90, "", 600, /*drawn_phase=*/true);
-  if (!spec.error.empty()) return {};
-  // As the campaign runs it: the estimator assumes its configured pixel noise.
-  const std::vector<ScenarioFrameResult> frames =
-      runMeasurementScenario(spec.scenario, config, {}, /*declare_config_pixel_noise=*/true);
-  if (frames.size() < 4) return {};
-  *first_new_points = frames[0].new_points;
-  constexpr int kYawL = 5;
-  std::vector<double> z;
-  for (int f = 0; f < 4; ++f) {
-    const double error =
-        std::remainder(frames[f].parameters(kYawL) - frames[f].truth(kYawL), 2.0 * M_PI);
-    z.push_back(std::abs(error) / frames[f].sigmas(kYawL));
-  }
-  return z;
-}
-
-TEST(Campaign, PointsBeyondInfinityKeptInFrontDoNotTurnTheLeftCameraAwayOnAStartsFirstUpdates) {
-  FilterConfig in_front;
-  in_front.keep_points_in_front = 1;
-  int new_points = 0, new_points_shipped = 0;
-  const std::vector<double> kept = run90StartYawL(in_front, &new_points);
-  const std::vector<double> shipped = run90StartYawL(FilterConfig(), &new_points_shipped);
-  ASSERT_EQ(kept.size(), 4u);
-  ASSERT_EQ(shipped.size(), 4u);
-  EXPECT_EQ(new_points, new_points_shipped);  // the pairs are kept, not refused (31)
-  EXPECT_GT(new_points, 20);
-  for (int f = 1; f < 4; ++f) {
-    EXPECT_LT(kept[f], 3.0) << "frame " << f;
-    EXPECT_GT(shipped[f], 5.0) << "frame " << f;  // measured 6.9, 8.9, 9.6
-  }
-}
-
-// Held out of the calibration's update instead (hold_out_points_beyond_infinity) they do not
-// either.
-TEST(Campaign, PointsBeyondInfinityHeldOutDoNotTurnTheLeftCameraAwayOnAStartsFirstUpdates) {
-  FilterConfig held_out;
-  held_out.hold_out_points_beyond_infinity = 1;
-  int new_points = 0;
-  const std::vector<double> held = run90StartYawL(held_out, &new_points);
-  ASSERT_EQ(held.size(), 4u);
-  EXPECT_GT(new_points, 20);
-  for (int f = 1; f < 4; ++f) EXPECT_LT(held[f], 3.0) << "frame " << f;
-}
-
-// The sideways camera of run 91 (drawn phase: a 9.6 cm rig, yaw_r 4.8 deg off at the start)
-// has points beyond infinity too: 43 frames beyond 5 sigma (yl 30 sigma), 39 % of the frames
-// within 3 sigma; kept in front, or held out of the calibration's update, it is honest.
-TEST(Campaign, ASidewaysStartWithPairsBeyondInfinityKeptInFrontEndsHonest) {
-  const CampaignRunSpec spec = shippedRun(91, "", 600, /*drawn_phase=*/true);
-  ASSERT_TRUE(spec.error.empty()) << spec.error;
-  ASSERT_EQ(settingOf(spec.settings, "mounting"), "sideways_right");
-  const CampaignRow kept = runShipped(spec, [](FilterConfig* c) { c->keep_points_in_front = 1; });
-  const CampaignRow shipped = runShipped(spec);
-  ASSERT_TRUE(kept.ok()) << kept.status;
-  ASSERT_TRUE(shipped.ok()) << shipped.status;
-  const CampaignRow held =
-      runShipped(spec, [](FilterConfig* c) { c->hold_out_points_beyond_infinity = 1; });
-  ASSERT_TRUE(held.ok()) << held.status;
-  EXPECT_TRUE(kept.honest()) << scoreText(kept);
-  EXPECT_TRUE(held.honest()) << scoreText(held);
-  EXPECT_GT(shipped.score.frames_beyond_5sigma, 20) << scoreText(shipped);  // measured 43
-}
-
-// Run 24 (drawn phase: a 0.26 m rig mounted backwards, yaw_r 4.7 deg off, the baseline +33 %
-// with a sigma of 0.1 m, known to 30 %) puts every stereo pair beyond infinity: no point for
-// 15 s, then yr 16 sigma off with the hold-out (docs/RESULTS.md "Session 38"), 2 frames beyond 5
-// sigma shipped. Turned by the disparity offset measured from the left camera's motion
-// (disparity_offset_turn) at frame 8, it is honest from the start.
-TEST(Campaign, ARotationThatKeepsEveryPairOutIsTurnedByTheDisparityOffsetFromMotion) {
-  const CampaignRunSpec spec = shippedRun(24, "", 600, /*drawn_phase=*/true);
-  ASSERT_TRUE(spec.error.empty()) << spec.error;
-  ASSERT_EQ(settingOf(spec.settings, "mounting"), "backward");
-  const CampaignRow turned =
-      runShipped(spec, [](FilterConfig* c) { c->disparity_offset_turn = 1; });
-  const CampaignRow waited =
-      runShipped(spec, [](FilterConfig* c) { c->disparity_offset_turn = 0; });
-  ASSERT_TRUE(turned.ok()) << turned.status;
-  ASSERT_TRUE(waited.ok()) << waited.status;
-  EXPECT_TRUE(turned.honest()) << scoreText(turned);
-  EXPECT_LT(turned.score.max_z, 3.5) << scoreText(turned);  // measured 2.53
-  EXPECT_GT(waited.score.max_z, 5.0) << scoreText(waited);  // measured 8.5
-}
-
-// Lines tilted off x_camr's may be tilted by its rotation or by its baseline's direction, so
-// the epipolar re-opening can widen both (epipolar_knock_baseline_direction): the translation
-// across the baseline, not its length.
-TEST(Campaign, ReopeningTheRightCameraWidensItsTranslationAcrossTheBaselineOnly) {
-  const CampaignRunSpec spec = shippedRun(92);
-  ASSERT_TRUE(spec.error.empty()) << spec.error;
-  MeasurementSimulator simulator(spec.scenario);
-  StereoCalibrationEstimator estimator(FilterConfig(), spec.scenario.left, spec.scenario.right,
-                                       simulator.initialGuess());
-  using namespace layout;
-  const Eigen::Vector3d before =
-      estimator.filter().covariance().diagonal().segment<3>(kCamr + kTranslation);
-  const Eigen::Vector3d baseline =
-      estimator.filter().extrinsics().T_caml_camr.translation().normalized();
-  const double across = 0.5;  // m, wider than the start's 0.1 m
-  estimator.reopenRightCameraRotation(0.1, across);
-  const Matrix12d after = estimator.filter().covariance();
-  for (int axis = 0; axis < 3; ++axis) {
-    const double expected =
-        std::max(before(axis), across * across * (1.0 - std::pow(baseline(axis), 2)));
-    EXPECT_NEAR(after(kCamr + kTranslation + axis, kCamr + kTranslation + axis), expected,
-                1e-9 * expected)
-        << "axis " << axis;
-    EXPECT_NEAR(after(kCamr + kRotation + axis, kCamr + kRotation + axis), 0.01, 1e-12);
-  }
-  // The baseline runs along y (yr): its length's variance is the start's.
-  EXPECT_GT(std::abs(baseline.y()), 0.99);
-  EXPECT_EQ(after(kCamr + kTranslation + 1, kCamr + kTranslation + 1), before(1));
-}
-
-// The same run: at frame 10 its baseline's direction is 5 deg off (xr 2.3 sigma) while x_camr's
-// rotation is 0.2-0.4 deg off, and the test against the rotation's covariance alone (the
-// default) takes the tilted epipolar lines for a knock, then stalls (above) with 164 frames
-// beyond 5 sigma. With the baseline direction's spread in the test's covariance
-// (epipolar_knock_baseline_direction) there is no re-opening but the real knock's.
-TEST(Campaign, AStartsUncertainBaselineDirectionIsNotTakenForAKnockWhenAllowedFor) {
-  const CampaignRunSpec drawn = shippedRun(92, "", 600, /*drawn_phase=*/true);
-  ASSERT_TRUE(drawn.error.empty()) << drawn.error;
-  ASSERT_EQ(settingOf(drawn.settings, "event_frame"), "280");
-  const std::string prefix = "the stereo pairs left x_camr's epipolar lines";
-  FilterConfig allowed_for;
-  allowed_for.epipolar_knock_baseline_direction = 1;
-  const std::vector<int> shipped = framesWarning(drawn, prefix);
-  ASSERT_FALSE(shipped.empty());
-  EXPECT_EQ(shipped.front(), 10);
-  // Its one re-opening is the knock's, at its first pair (0.15 deg at frame 280).
-  EXPECT_EQ(framesWarning(drawn, prefix, allowed_for), std::vector<int>{280});
-  const CampaignRow row =
-      runShipped(drawn, [](FilterConfig* c) { c->epipolar_knock_baseline_direction = 1; });
-  ASSERT_TRUE(row.ok()) << row.status;
-  EXPECT_EQ(row.score.frames_beyond_5sigma, 0) << scoreText(row);  // measured: 0 (164 shipped)
-  EXPECT_TRUE(row.honest()) << scoreText(row);                     // measured: 1.000
-}
-
-TEST(Campaign, TheConvergedStateIsReachedAndNotConfidentlyWrong) {
+TEST_F(CampaignRun, TheConvergedStateIsReachedAndNotConfidentlyWrong) {
   int converged = 0, converged_off = 0, overconfident_converged = 0, overconfident_off = 0;
   for (int run = 0; run < 10; ++run) {
     const CampaignRunSpec spec = shippedRun(run);
@@ -807,42 +733,7 @@ TEST(Campaign, TheConvergedStateIsReachedAndNotConfidentlyWrong) {
       << overconfident_off << " of " << overconfident_converged;
 }
 
-// The errors-in-variables compensation (errors_in_variables.h) on the weak-stereo bench of
-// docs/RESULTS.md "Session 32" (0.125 m at 564 px looking sideways from a car at 14 m/s,
-// nothing else wrong), with the odometry's scale taken as exact so that the baseline's sigma
-// is what its points tell. Uncompensated (the default), the baseline is estimated long in
-// every run (the regression on the points' noisy stereo depths shrinks the camera's measured
-// translation).
-TEST(Campaign, AWeakStereoRigsBaselineIsNotEstimatedLongFromItsPointsDepthNoise) {
-  const std::string dir = std::string(OSC_SOURCE_DIR) + "/docs/results/campaign";
-  CampaignInputs inputs;
-  inputs.ranges_text = readTextFile(dir + "/F_sideways_weak_stereo.yaml");
-  inputs.ranges = parseCampaignRanges(inputs.ranges_text, "F_sideways_weak_stereo.yaml", dir);
-  inputs.frames = 600;
-  constexpr int kRuns = 10;
-  constexpr int kBaseline = layout::kCamr + layout::kTranslation + 1;  // yr
-  double compensated = 0.0, uncompensated = 0.0;
-  for (int run = 0; run < kRuns; ++run) {
-    const CampaignRunSpec spec = drawCampaignRun(inputs, run);
-    ASSERT_TRUE(spec.error.empty()) << spec.error;
-    const CampaignRow on = runShipped(spec, [](FilterConfig* c) {
-      c->odometry_scale_sigma = 0.0;  // as the option's documentation advises
-      c->errors_in_variables_compensation = 1;
-    });
-    const CampaignRow off =
-        runShipped(spec, [](FilterConfig* c) { c->odometry_scale_sigma = 0.0; });
-    ASSERT_TRUE(on.ok()) << on.status;
-    ASSERT_TRUE(off.ok()) << off.status;
-    compensated += on.score.mean_z[kBaseline] / kRuns;
-    uncompensated += off.score.mean_z[kBaseline] / kRuns;
-  }
-  // Measured: the runs' mean signed error / sigma +0.20 (their spread 0.7: about +-0.22 for
-  // the mean of ten) against -1.31.
-  EXPECT_LT(std::abs(compensated), 0.65);
-  EXPECT_LT(uncompensated, -0.8);
-}
-
-TEST(Campaign, AYawStepOfTheLeftCameraOnAFlatRoadIsDetectedThoughZlStaysOpen) {
+TEST_F(CampaignRun, AYawStepOfTheLeftCameraOnAFlatRoadIsDetectedThoughZlStaysOpen) {
   // Run 121 of the shipped ranges (config/campaign.yaml, seed 122): a sideways-left camera on
   // an urban (planar) drive, x_caml yawed by -4.8 deg at frame 301. zl cannot be determined on
   // a flat road, so its sigma stays far above the re-opened jump_translation_sigma; when that
@@ -872,7 +763,7 @@ TEST(Campaign, AYawStepOfTheLeftCameraOnAFlatRoadIsDetectedThoughZlStaysOpen) {
   EXPECT_GT(translations_first.score.rmse[kYawL], 0.5 * kDeg);  // measured: 0.96 deg
 }
 
-TEST(Campaign, AYawStepOfASidewaysCameraReopensOnlyTheTurnedAxis) {
+TEST_F(CampaignRun, AYawStepOfASidewaysCameraReopensOnlyTheTurnedAxis) {
   // Run 144 of the shipped ranges: a sideways-right camera on a flat urban drive, x_caml
   // yawed by 8.8 deg at frame 304. Re-opened to 10 deg on every axis, pitch_l (about the
   // direction of travel, which only turns tell) locked ~3 sigma off at sigma 1 deg for 100
@@ -897,7 +788,7 @@ TEST(Campaign, AYawStepOfASidewaysCameraReopensOnlyTheTurnedAxis) {
   EXPECT_GT(every_axis.score.rmse[kPitchL], 0.4 * kDeg) << every_axis.score.rmse[kPitchL] / kDeg;
 }
 
-TEST(Campaign, ADronesForwardVelocityErrorIsEstimatedNotTakenForAYawOfTheRightCamera) {
+TEST_F(CampaignRun, ADronesForwardVelocityErrorIsEstimatedNotTakenForAYawOfTheRightCamera) {
   // Run 40 of the shipped ranges without its event: a 0.28 m rig on a recorded EuRoC drone
   // stretch (~0.4 m/s) whose odometry has a velocity error of 0.019 m/s per axis, 5 % of the
   // motion along the drone's forward axis. With only the lateral and vertical errors as
@@ -925,7 +816,7 @@ TEST(Campaign, ADronesForwardVelocityErrorIsEstimatedNotTakenForAYawOfTheRightCa
   EXPECT_EQ(lateral_only.score.max_z_parameter, "yaw_r");
 }
 
-TEST(Campaign, AKnockDuringAStretchWithoutPointsIsDetectedOnceNewPointsDisagree) {
+TEST_F(CampaignRun, AKnockDuringAStretchWithoutPointsIsDetectedOnceNewPointsDisagree) {
   // Run 94 of the shipped ranges: x_camr is knocked by 0.5 deg at frame 293, while no point
   // is seen (a 3.2 s blind stretch). The new points after it are triangulated with the old
   // x_camr; 30-60 % of their next measurements were gated out per frame, never the 60 % of
@@ -959,7 +850,7 @@ TEST(Campaign, AKnockDuringAStretchWithoutPointsIsDetectedOnceNewPointsDisagree)
   EXPECT_GE(shipped.score.first_frame_beyond_5sigma, 293);    // not before the knock
 }
 
-TEST(Campaign, AKnockInsideABlindStretchIsFoundOnTheEpipolarLinesNotBlamedOnTheLeftCamera) {
+TEST_F(CampaignRun, AKnockInsideABlindStretchIsFoundOnTheEpipolarLinesNotBlamedOnTheLeftCamera) {
   // Run 102 of the shipped ranges: a 0.127 m rig looking sideways, x_camr knocked by 0.69 deg
   // at frame 357 inside a 4.7 s blind stretch (frames 349-395). The points after it are new,
   // triangulated with the old x_camr at wrong depths, so their next left pixels fail too and
@@ -982,7 +873,7 @@ TEST(Campaign, AKnockInsideABlindStretchIsFoundOnTheEpipolarLinesNotBlamedOnTheL
   EXPECT_GT(without.score.frames_beyond_5sigma, 200) << scoreText(without);  // measured: 243
 }
 
-TEST(Campaign, AStandingCarsOdometryNoiseIsNotTakenForParallax) {
+TEST_F(CampaignRun, AStandingCarsOdometryNoiseIsNotTakenForParallax) {
   // Run 106 of the shipped ranges: an 8.5 cm rig on an urban drive at 14.9 m/s with one
   // 7.2 s stop. While the car stands, its measured translation per step is the odometry's
   // noise, and a prediction linearised there (depth times translation) fakes a metric
@@ -1005,7 +896,7 @@ TEST(Campaign, AStandingCarsOdometryNoiseIsNotTakenForParallax) {
   EXPECT_GT(without.score.max_z, 6.0) << scoreText(without);                 // measured: 8.6
 }
 
-TEST(Campaign, AKnockTooSmallToGateOutPointsIsCaughtByItsScoreInTwoUpdates) {
+TEST_F(CampaignRun, AKnockTooSmallToGateOutPointsIsCaughtByItsScoreInTwoUpdates) {
   // Run 23 of the shipped ranges: x_camr knocked by 0.15 deg at frame 339 (a walking rig,
   // 15 cm baseline, no blind stretch). roll_r is 43 sigma off at once, but no point is gated
   // out: each point's right pixel moves by less than a pixel. Without the score test the
@@ -1036,7 +927,7 @@ TEST(Campaign, AKnockTooSmallToGateOutPointsIsCaughtByItsScoreInTwoUpdates) {
   EXPECT_GT(without.score.frames_beyond_5sigma, 20);  // measured: 30
 }
 
-TEST(Campaign, AKnocksFirstPairOffTheEpipolarLinesReopensTheRightCamera) {
+TEST_F(CampaignRun, AKnocksFirstPairOffTheEpipolarLinesReopensTheRightCamera) {
   // Run 23 of the shipped ranges again (x_camr knocked by 0.15 deg at frame 339). The pairs
   // leave the epipolar lines at frame 339 already (statistic 48 for a bound of 33). Waiting
   // for a second such pair (epipolar_knock_pairs 2, sessions 21-23) left that frame's
@@ -1056,7 +947,7 @@ TEST(Campaign, AKnocksFirstPairOffTheEpipolarLinesReopensTheRightCamera) {
   EXPECT_GT(two_pairs.score.max_z, 10.0) << scoreText(two_pairs);  // measured: 32.5
 }
 
-TEST(Campaign, ASteadyDriftOfTheRightCameraIsFollowedByItsRateWithoutALagBeyondItsSigma) {
+TEST_F(CampaignRun, ASteadyDriftOfTheRightCameraIsFollowedByItsRateWithoutALagBeyondItsSigma) {
   // Run 28 of the shipped ranges: a 0.46 m rig looking forward on an urban drive while
   // x_camr turns by 0.19 deg/min about a fixed axis and moves 4.9 mm/min (a thermal drift).
   // With the random walk alone (and the consistency monitor raising it) roll_r lagged the
@@ -1076,7 +967,7 @@ TEST(Campaign, ASteadyDriftOfTheRightCameraIsFollowedByItsRateWithoutALagBeyondI
   EXPECT_GT(walk_only.score.max_z, 3.5);
 }
 
-TEST(Campaign, AStartFarFromTheTruthIsTemperedNotLockedIn) {
+TEST_F(CampaignRun, AStartFarFromTheTruthIsTemperedNotLockedIn) {
   // Run 11 of the shipped ranges: a fisheye camera on an urban drive, the baseline guessed
   // 42 % short. Untempered, the first updates, linearised there, locked yaw_r 25 sigma off
   // (138 frames beyond 5 sigma from frame 30). Tempered to a threefold shrink of a sigma per
@@ -1111,7 +1002,7 @@ TEST(Campaign, AStartFarFromTheTruthIsTemperedNotLockedIn) {
   EXPECT_GT(untempered.score.max_z, 20.0);                // measured: 25 (yaw_r)
 }
 
-TEST(Campaign, AJerkyRigWithATimeOffsetIsNotTakenForAKnock) {
+TEST_F(CampaignRun, AJerkyRigWithATimeOffsetIsNotTakenForAKnock) {
   // Run 147 of the shipped ranges: a backward camera carried around a building at walking
   // pace (the recorded udel_gore stretch: twists changing at 200-500 deg/s^2), odometry 24 ms
   // ahead. The first-order time-offset correction alone errs there by ~0.1 deg per step, 5x
@@ -1133,7 +1024,7 @@ TEST(Campaign, AJerkyRigWithATimeOffsetIsNotTakenForAKnock) {
   EXPECT_GT(first_order_only.score.frames_beyond_5sigma, 100);  // measured: 243
 }
 
-TEST(Campaign, TheOdometryReadAtTheEstimatedOffsetKeepsAWalkingRigHonest) {
+TEST_F(CampaignRun, TheOdometryReadAtTheEstimatedOffsetKeepsAWalkingRigHonest) {
   // Run 189: the walking rig again, a side camera, odometry 30 ms ahead. Read at the image
   // stamps, even with the correction's error in the motion noise, roll_l ended 7 sigma off
   // (171 frames beyond 5 sigma; since a re-linearisation restart keeps the learned time
@@ -1154,7 +1045,7 @@ TEST(Campaign, TheOdometryReadAtTheEstimatedOffsetKeepsAWalkingRigHonest) {
   EXPECT_LT(at_stamps.score.share_within_3sigma, 0.8) << scoreText(at_stamps);  // measured: 0.61
 }
 
-TEST(Campaign, AStartThatMovedFarIsRestartedThoughItsInnovationsLookAsExpected) {
+TEST_F(CampaignRun, AStartThatMovedFarIsRestartedThoughItsInnovationsLookAsExpected) {
   // A start's wide sigmas dominate the expected innovations, so a linearisation far off need
   // not show in them. Run 143 of the shipped ranges (a sideways camera on a recorded EuRoC
   // drone path, the baseline guessed 21 % short, x_camr's angles 4.2 deg off) moved 2.1 start
@@ -1178,41 +1069,29 @@ TEST(Campaign, AStartThatMovedFarIsRestartedThoughItsInnovationsLookAsExpected) 
   }
 }
 
-TEST(Campaign, TheThinEvidenceFloorKeepsAGuessThatTriangulatesAlmostNoPointOpen) {
+TEST_F(CampaignRun, ACollapsedGuessThatTriangulatesAlmostNoPointIsReopenedOnItsEpipolarLines) {
   // Run 24: a backward camera on an urban drive, the baseline guessed 33 % long and x_camr's
   // angles 4.7 deg off. Almost no pair triangulates within the depth range with that guess:
-  // one point in 600 frames. Shipped, that one point's updates take yaw_r's sigma from 2 to
-  // 0.7 deg while it is 5.1 deg off (435 frames beyond 5 sigma). With the thin-evidence floor
-  // (thin_evidence_points 20, off by default: it costs at image level, docs/RESULTS.md
-  // "Session 17"), the sigmas stay near their start until 20 points were measured, and the
-  // run is honest (the estimator says it cannot initialise points; the calibration stays open).
-  // Since session 21 the shipped run is rescued otherwise: the pairs leave the collapsed
-  // x_camr's epipolar lines and its rotation is re-opened (frame 166; 1 frame beyond 5 sigma).
-  // "without" is without that test and without the step repeated at the corrected motion
-  // while slow (session 22: with it 70 frames beyond 5 sigma).
+  // one point in 600 frames. Without the epipolar knock test (and without the step repeated
+  // at the corrected motion while slow), that one point's updates take yaw_r's sigma from 2
+  // to 0.7 deg while it is 5.1 deg off (435 frames beyond 5 sigma). Shipped, the pairs leave
+  // the collapsed x_camr's epipolar lines and its rotation is re-opened (frame 166; 1 frame
+  // beyond 5 sigma).
   const CampaignRunSpec spec = shippedRun(24);
   ASSERT_TRUE(spec.error.empty()) << spec.error;
   ASSERT_EQ(settingOf(spec.settings, "mounting"), "backward");
-  ASSERT_EQ(EstimatorConfig().filter.thin_evidence_points, 0);
-  const auto no_epipolar_test = [](FilterConfig* c) {
+  const CampaignRow shipped = runShipped(spec);
+  const CampaignRow without = runShipped(spec, [](FilterConfig* c) {
     c->epipolar_knock_false_alarm = 0.0;
     c->motion_relinearizations = 0;
-  };
-  const CampaignRow shipped = runShipped(spec);
-  const CampaignRow without = runShipped(spec, no_epipolar_test);
-  const CampaignRow floored = runShipped(spec, [&](FilterConfig* c) {
-    no_epipolar_test(c);
-    c->thin_evidence_points = 20;
   });
   ASSERT_TRUE(shipped.ok()) << shipped.status;
   ASSERT_TRUE(without.ok()) << without.status;
-  ASSERT_TRUE(floored.ok()) << floored.status;
-  EXPECT_TRUE(floored.honest()) << scoreText(floored);
   EXPECT_GT(without.score.frames_beyond_5sigma, 100);                       // measured: 435
   EXPECT_LT(shipped.score.frames_beyond_5sigma, 10) << scoreText(shipped);  // measured: 1
 }
 
-TEST(Campaign, AYawStepOfTheLeftCameraInABlindStretchIsReopenedWhenThePointsReturn) {
+TEST_F(CampaignRun, AYawStepOfTheLeftCameraInABlindStretchIsReopenedWhenThePointsReturn) {
   // Run 9 of the shipped ranges at 200 frames (as the image campaign draws them): a backward
   // camera on an off-road drive, x_caml yawed by -2.5 deg at frame 88 inside a 3.7 s blind
   // stretch. No tracked point outlives the stretch, so none gates out and the jump test sees
@@ -1466,7 +1345,7 @@ TEST(Campaign, OverconfidentConfigurationIsNotHonestTheShippedOneIs) {
   EXPECT_NE(summary.find("frames_beyond_5sigma = 0): 0 of 4 (0 %)"), std::string::npos) << summary;
 }
 
-TEST(Campaign, InverseDepthPointsKeepAnEasyRunHonestThatPositionsMadeConfidentlyWrong) {
+TEST_F(CampaignRun, InverseDepthPointsKeepAnEasyRunHonestThatPositionsMadeConfidentlyWrong) {
   // Run 25 of the easy ranges docs/results/campaign/B_clean.yaml (seed 26): a 0.56 m rig
   // looking forward on the recorded EuRoC MAV trajectory, start errors within the prior.
   // Stored as positions, the first points' depths were +-100 % uncertain and non-Gaussian and

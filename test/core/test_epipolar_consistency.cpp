@@ -137,49 +137,5 @@ TEST(EpipolarLines, MismatchesAloneDoNotContradict) {
   EXPECT_EQ(contradicting, 0);
 }
 
-// A baseline direction 5 deg off (xr and zr 2 cm on the 0.3 m rig; in a start, default
-// campaign run 92 had 5 deg on a 0.47 m rig) tilts the epipolar lines too, and the test
-// against the rotation's covariance alone (the translation taken as exact, the default) takes
-// that for a knock. With the baseline direction's spread (epipolar_knock_baseline_direction)
-// and that tilt within x_camr's translation covariance, it is none.
-TEST(EpipolarLines, AnUncertainBaselineDirectionIsNotTakenForAKnockWhenAllowedFor) {
-  std::mt19937 rng(13);
-  Vector12d parameters = rig().toParameters();
-  parameters(6) = parameters(8) = 0.02;
-  const StereoExtrinsics truth = StereoExtrinsics::fromParameters(parameters);
-  const Matrix6d uncertain_translation = camrCovariance(0.01 * kDeg, 0.02);
-  int allowed_for = 0, rotation_alone = 0, exact = 0;
-  for (int trial = 0; trial < 20; ++trial) {
-    const std::vector<PointMeasurement> measured = pairs(truth, 80, 0.5, &rng);
-    allowed_for += testEpipolarLines(measured, intrinsics(), intrinsics(), rig(),
-                                     uncertain_translation, 1e-6, 8, true)
-                       .contradicts;
-    rotation_alone += testEpipolarLines(measured, intrinsics(), intrinsics(), rig(),
-                                        uncertain_translation, 1e-6, 8, false)
-                          .contradicts;
-    exact += testEpipolarLines(measured, intrinsics(), intrinsics(), rig(),
-                               camrCovariance(0.01 * kDeg, 1e-5), 1e-6, 8, true)
-                 .contradicts;
-  }
-  EXPECT_EQ(allowed_for, 0);
-  EXPECT_GE(rotation_alone, 15);
-  EXPECT_GE(exact, 15);  // a translation known exactly: the spread does not hide the tilt
-}
-
-// Without the translation's spread both forms are the same test: the same statistic.
-TEST(EpipolarLines, TheBaselineDirectionsShareVanishesWithItsSpread) {
-  std::mt19937 rng(17);
-  const StereoExtrinsics truth = rig(0.2 * kDeg, -0.1 * kDeg, 0.05 * kDeg);
-  const std::vector<PointMeasurement> measured = pairs(truth, 60, 0.5, &rng);
-  Matrix6d rotation_only = camrCovariance(0.05 * kDeg, 0.0);
-  const EpipolarEvidence with =
-      testEpipolarLines(measured, intrinsics(), intrinsics(), rig(), rotation_only, 1e-6, 8, true);
-  const EpipolarEvidence without =
-      testEpipolarLines(measured, intrinsics(), intrinsics(), rig(), rotation_only, 1e-6, 8, false);
-  EXPECT_EQ(with.dof, without.dof);
-  EXPECT_GT(without.statistic, 10.0);
-  EXPECT_NEAR(with.statistic, without.statistic, 1e-6 * without.statistic);
-}
-
 }  // namespace
 }  // namespace osc

@@ -118,7 +118,7 @@ TEST(Kitti, DISABLED_Diagnostic) {
     start.tail<3>().setConstant((std::getenv("D_ANGLE") ? std::atof(std::getenv("D_ANGLE")) : 0.5) *
                                 kDeg);
     // D_ROT_NOISE (deg), D_TRANS_NOISE (m), D_PIXEL_NOISE (px) override the filter's noises;
-    // D_FIT, D_FIT_DISTANCE and D_EIV (errors_in_variables_compensation) its options.
+    // D_FIT and D_FIT_DISTANCE its options.
     FilterConfig config;
     if (std::getenv("D_ROT_NOISE"))
       config.motion_rotation_noise = std::atof(std::getenv("D_ROT_NOISE")) * kDeg;
@@ -130,8 +130,6 @@ TEST(Kitti, DISABLED_Diagnostic) {
     if (std::getenv("D_FIT_DISTANCE"))
       config.stereo_fit_restart_distance = std::atof(std::getenv("D_FIT_DISTANCE"));
     if (std::getenv("D_FIT")) config.stereo_fit_start = std::atoi(std::getenv("D_FIT"));
-    if (std::getenv("D_EIV"))
-      config.errors_in_variables_compensation = std::atoi(std::getenv("D_EIV"));
     const KittiRun run = runKitti(sequence, start, config);
     for (size_t k = 0; k < run.errors.size(); k += 5) {
       const Vector12d& e = run.errors[k];

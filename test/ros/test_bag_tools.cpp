@@ -130,7 +130,9 @@ TEST(ScenarioFile, ShippedScenariosParse) {
 
 TEST(ScenarioFile, EurocRigFromSensorYaml) {
   const std::string path = std::string(OSC_SOURCE_DIR) + "/config/scenarios/mav_euroc.yaml";
-  if (!isFile(std::string(OSC_SOURCE_DIR) + "/../shared/data/README.md")) GTEST_SKIP();
+  const std::string data = std::string(OSC_SOURCE_DIR) + "/../shared/data/README.md";
+  if (!isFile(data))
+    GTEST_SKIP() << "needs the EuRoC data of ../shared/data: " << data << " not found";
   const osc::SimulationScenario s = osc::readScenarioFile(path);
   EXPECT_EQ(s.measurement.left.width, 752);
   EXPECT_DOUBLE_EQ(s.measurement.left.fx, 458.654);

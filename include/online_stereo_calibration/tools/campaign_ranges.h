@@ -58,6 +58,11 @@ struct CampaignRanges {
   /// The recorded trajectories (TUM files, sorted) found in `trajectories_dir`; empty when the
   /// kind `recorded` has weight 0.
   std::vector<std::string> trajectory_files;
+  /// Why the kind `recorded` was dropped (its weight set to 0, the other motions drawn):
+  /// `trajectories_dir` is not a directory or holds no *.tum file (a clone without the
+  /// project's ../shared/data beside it). Empty when nothing was dropped. The runs then
+  /// differ from those drawn with the trajectories: every kind's share changes.
+  std::string dropped_recorded;
 
   // --- start errors (each axis: |error| drawn, sign random) -------------------------------
   DrawRange caml_translation_error_m{0, 0.5};      ///< start_errors.caml_translation_m
@@ -116,10 +121,13 @@ const std::vector<KindChoiceSpec>& kindChoiceSpecs();
 
 /// Reads ranges from YAML text; keys not given keep the defaults of CampaignRanges.
 /// `trajectories_dir` is resolved against @p base_dir (the ranges file's directory), then
-/// the current directory; it must hold *.tum files when the kind `recorded` has weight > 0.
+/// the current directory. When the kind `recorded` has weight > 0 but that directory is
+/// missing or holds no *.tum file, `recorded` is dropped and CampaignRanges::dropped_recorded
+/// says why (an error if no other motion kind has weight).
 /// @throws std::runtime_error "<source_name>: invalid ranges:" listing every problem, each
 /// naming its key (unknown keys, not a number or [min, max], min > max, outside the limits,
-/// unknown kinds, bad weights, trajectories_dir missing or empty).
+/// unknown kinds, bad weights, trajectories_dir not given or, with no other motion kind,
+/// missing or empty).
 CampaignRanges parseCampaignRanges(const std::string& text, const std::string& source_name,
                                    const std::string& base_dir = ".");
 

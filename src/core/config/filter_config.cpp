@@ -98,18 +98,8 @@ const std::vector<ParameterSpec>& filterParameterTable() {
       integer("max_points", &C::max_points, 1, 100000, "points kept in the filter state"),
       integer("inverse_depth_points", &C::inverse_depth_points, 0, 1,
               "1: points as inverse depth (x/z, y/z, 1/z), 0: as positions (the seed's)"),
-      integer("keep_points_in_front", &C::keep_points_in_front, 0, 1,
-              "1: an inverse-depth point beyond infinity (negative inverse depth) is moved to "
-              "the farthest depth, covariance kept (measured mixed: docs/RESULTS.md Session 36)"),
-      integer("hold_out_points_beyond_infinity", &C::hold_out_points_beyond_infinity, 0, 1,
-              "1: an inverse-depth point beyond infinity updates itself but not the "
-              "calibration until it is back in front (docs/RESULTS.md Session 38)"),
       integer("baseline_scaled_points", &C::baseline_scaled_points, 0, 1,
               "1: points in units of the baseline (what stereo measures), 0: metric (the seed's)"),
-      integer("errors_in_variables_compensation", &C::errors_in_variables_compensation, 0, 1,
-              "1: the update compensates the bias of regressing on a point's noisy stereo depth "
-              "(the baseline estimated long; for a small baseline with a calibrated odometry "
-              "scale), 0: not (measured mixed on other drives: docs/RESULTS.md Session 33)"),
       real("max_speed_mps", &C::max_speed, 1.0, 0.0, 1e4,
            "a motion increment faster than this is rejected as corrupt"),
       real("max_angular_rate_dps", &C::max_angular_rate, kDeg, 0.0, 1e5,
@@ -148,10 +138,6 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "x_camr's epipolar lines (a knocked right camera; epipolar_consistency.h); 0 = off"),
       integer("epipolar_knock_pairs", &C::epipolar_knock_pairs, 1, 1000,
               "image pairs in a row beyond that bound before x_camr's rotation is re-opened"),
-      integer("epipolar_knock_baseline_direction", &C::epipolar_knock_baseline_direction, 0, 1,
-              "1: that test allows for the baseline direction's spread and a knock re-opens "
-              "the translation across the baseline too, 0: the rotation's alone (measured "
-              "mixed: docs/RESULTS.md Session 35)"),
       integer("relinearization_frames", &C::relinearization_frames, 0, 100000,
               "frames between checks whether the estimate left its start (linearisation) "
               "point; 0 = never restart"),
@@ -174,13 +160,6 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "largest factor by which one update may shrink a calibration sigma; a larger "
            "shrink (a start or re-opening far off) is tempered and spread over frames; "
            "0 = off"),
-      integer("thin_evidence_points", &C::thin_evidence_points, 0, 100000,
-              "until this many distinct points have been measured since a start or "
-              "re-opening, no started sigma falls below its start value / "
-              "thin_evidence_max_shrink; 0 = off"),
-      real("thin_evidence_max_shrink", &C::thin_evidence_max_shrink, 1.0, 1.0, 1e6,
-           "how far below its start value a sigma may fall on thin evidence (see "
-           "thin_evidence_points)"),
       integer("min_points_to_update", &C::min_points_to_update, 0, 100000,
               "a pair with fewer stereo pairs than this (tracked and new) does not update the "
               "calibration (the filter predicts; its points start afresh); 0 = update on any "
@@ -189,11 +168,6 @@ const std::vector<ParameterSpec>& filterParameterTable() {
               "while no point can be initialised (a baseline guess far off), measure the "
               "baseline's length from the left camera's motion at the odometry's scale and "
               "restart x_camr's translation from it; 0 = off"),
-      integer("disparity_offset_turn", &C::disparity_offset_turn, 0, 1,
-              "1: while no point can be initialised and the baseline's length is known, turn "
-              "x_camr by the disparity offset measured from the left camera's motion"),
-      real("max_disparity_offset_turn_deg", &C::max_disparity_offset_turn, kDeg, 0.0, 90.0,
-           "the largest turn disparity_offset_turn makes"),
       real("initial_time_offset_ms", &C::initial_time_offset, 1e-3, -1000.0, 1000.0,
            "prior mean of the camera clock minus the odometry clock (the odometry's sample "
            "stamped t holds the vehicle at camera time t + offset; a late-stamping odometry "
@@ -344,8 +318,7 @@ FilterConfig paperFilterConfig() {
   config.epipolar_knock_false_alarm = 0.0;    // ... only
   config.relinearization_frames = 0;          // the paper's filter runs on from its start
   config.max_sigma_shrink_per_update = 0.0;   // ... and updates as the UKF does
-  config.thin_evidence_points = 0;            // ... on any evidence
-  config.min_points_to_update = 0;            // ... however few points
+  config.min_points_to_update = 0;            // ... on however few points
   config.baseline_from_motion = 0;            // ... and the baseline from its points alone
   config.initial_time_offset_sigma = 0.0;     // the paper takes the odometry as synchronised
   config.odometry_scale_sigma = 0.0;          // ... and exact in scale
@@ -354,7 +327,6 @@ FilterConfig paperFilterConfig() {
   config.camr_rotation_drift_rate_sigma = 0.0;  // ... and a right camera that does not drift
   config.inverse_depth_points = 0;              // the paper's points are positions
   config.baseline_scaled_points = 0;            // ... in metres
-  config.errors_in_variables_compensation = 0;  // ... and its update is the plain UKF's
   return config;
 }
 

@@ -19,16 +19,11 @@ constexpr double kHuber = 3.0;          // normalised residuals beyond this are 
 constexpr int kReweightings = 3;        // Huber iterations
 constexpr double kRelativeRank = 1e-6;  // eigenvalues below this share of the largest: no info
 
-/// The directions of x_camr the epipolar lines can tell: the translation across the baseline
-/// (two) and the rotation (three). The baseline's length does not enter the normalised
-/// residual (F is scale-free).
-using Directions = Eigen::Matrix<double, 5, 1>;
-using DirectionsMatrix = Eigen::Matrix<double, 5, 5>;
-
-/// One pair's residual normalised by its noise, and its derivative in those directions.
+/// One pair's residual normalised by its noise, and its derivative in x_camr's rotation
+/// (boxPlus tangent).
 struct NormalisedResidual {
   double r = 0.0;
-  Directions a = Directions::Zero();
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();
 };
 
 }  // namespace
@@ -45,30 +40,20 @@ EpipolarEvidence testEpipolarLines(const std::vector<PointMeasurement>& pairs,
                                    const Eigen::Matrix3d& K_left, const Eigen::Matrix3d& K_right,
                                    const StereoExtrinsics& extrinsics,
                                    const Matrix6d& camr_covariance, double false_alarm,
-                                   int min_pairs, bool with_baseline_direction) {
+                                   int min_pairs) {
   EpipolarEvidence evidence;
-  // F of x_camr moved by +-kStep along each tangent axis (boxPlus of T_caml_camr).
+  // F of x_camr moved by the tangent [dt, dtheta] (boxPlus of T_caml_camr); its derivative
+  // along each rotation axis by central differences. (A zero baseline has no epipolar lines:
+  // F = 0 and every pair is skipped below.)
   const auto fundamental = [&](const Vector6d& delta) {
     StereoExtrinsics moved = extrinsics;
     moved.T_caml_camr = boxPlus(extrinsics.T_caml_camr, delta);
     return fundamentalMatrix(K_left, K_right, moved.leftToRightOptical());
   };
-  // The tangent [dt, dtheta] along the five directions: dt across the baseline (boxPlus adds
-  // dt in the left camera's body frame, where the baseline is t), dtheta as it is.
-  // (A zero baseline has no epipolar lines: F = 0 and every pair is skipped below.)
-  const Eigen::Vector3d t = extrinsics.T_caml_camr.translation();
-  const Eigen::Vector3d baseline =
-      t.norm() > 0.0 ? Eigen::Vector3d(t / t.norm()) : Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d helper =
-      std::abs(baseline.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  Eigen::Matrix<double, 6, 5> directions = Eigen::Matrix<double, 6, 5>::Zero();
-  directions.block<3, 1>(0, 0) = baseline.cross(helper).normalized();
-  directions.block<3, 1>(0, 1) = baseline.cross(directions.block<3, 1>(0, 0));
-  directions.block<3, 3>(3, 2) = Eigen::Matrix3d::Identity();
   const Eigen::Matrix3d F = fundamental(Vector6d::Zero());
-  std::array<Eigen::Matrix3d, 5> dF;
-  for (int k = 0; k < 5; ++k) {
-    const Vector6d delta = kStep * directions.col(k);
+  std::array<Eigen::Matrix3d, 3> dF;
+  for (int k = 0; k < 3; ++k) {
+    const Vector6d delta = kStep * Vector6d::Unit(3 + k);
     dF[static_cast<size_t>(k)] = (fundamental(delta) - fundamental(-delta)) / (2.0 * kStep);
   }
 
@@ -84,7 +69,7 @@ EpipolarEvidence testEpipolarLines(const std::vector<PointMeasurement>& pairs,
     const double sigma = std::sqrt(variance);
     NormalisedResidual n;
     n.r = xr.dot(Fxl) / sigma;
-    for (int k = 0; k < 5; ++k) n.a(k) = xr.dot(dF[static_cast<size_t>(k)] * xl) / sigma;
+    for (int k = 0; k < 3; ++k) n.a(k) = xr.dot(dF[static_cast<size_t>(k)] * xl) / sigma;
     residuals.push_back(n);
   }
   evidence.pairs = static_cast<int>(residuals.size());
@@ -102,7 +87,7 @@ EpipolarEvidence testEpipolarLines(const std::vector<PointMeasurement>& pairs,
     b_rotation.setZero();
     for (size_t i = 0; i < residuals.size(); ++i) {
       const NormalisedResidual& n = residuals[i];
-      const Eigen::Vector3d a = n.a.tail<3>();  // the rotation's columns
+      const Eigen::Vector3d& a = n.a;
       const double left = std::abs(n.r + a.dot(shift));
       weights[i] = left > kHuber ? kHuber / left : 1.0;
       H_rotation += weights[i] * a * a.transpose();
@@ -113,24 +98,15 @@ EpipolarEvidence testEpipolarLines(const std::vector<PointMeasurement>& pairs,
   evidence.rotation_shift = shift;
   evidence.angle = shift.norm();
 
-  // b = sum a_theta r, the rotation's score, has the covariance S = H + H P_theta H if x_camr
-  // holds within its covariance and its translation is exact: T = b^T S^+ b, the shipped
-  // test. With the baseline direction's spread (with_baseline_direction) it is C = H + M P M^T
-  // (M = sum a_theta a^T over all five directions), which also tilts the lines, and
-  // T = b_U^T (U^T C U)^-1 b_U. Against S a start's uncertain baseline direction was taken for
-  // a knock (default campaign run 92 with a drawn steering phase: x_camr's rotation re-opened
-  // to 8.5 deg while it was 0.4 deg off, its xr 2.3 sigma).
-  DirectionsMatrix information = DirectionsMatrix::Zero();
-  Directions score = Directions::Zero();
+  // b = sum a r, the rotation's score, has the covariance S = H + H P_theta H if x_camr holds
+  // within its covariance and its translation is exact: T = b^T S^+ b over the rotations the
+  // pairs inform (the eigenvectors of S above kRelativeRank of the largest).
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < residuals.size(); ++i) {
-    information += weights[i] * residuals[i].a * residuals[i].a.transpose();
-    score += weights[i] * residuals[i].a * residuals[i].r;
+    H += weights[i] * residuals[i].a * residuals[i].a.transpose();
+    b += weights[i] * residuals[i].a * residuals[i].r;
   }
-  const Eigen::Vector3d b = score.tail<3>();
-  const Eigen::Matrix3d H = information.bottomRightCorner<3, 3>();
-  // Scored over the rotations U that the test against the rotation's covariance alone keeps
-  // (the eigenvectors of S = H + H P_theta H above kRelativeRank of the largest): with or
-  // without the baseline direction the same degrees of freedom and bound.
   const Eigen::Matrix3d P_rotation = camr_covariance.bottomRightCorner<3, 3>();
   const Eigen::Matrix3d S = H + H * P_rotation * H;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(0.5 * (S + S.transpose()));
@@ -150,17 +126,7 @@ EpipolarEvidence testEpipolarLines(const std::vector<PointMeasurement>& pairs,
     rotation_alone += projection * projection / lambda(k);
   }
   evidence.bound = chiSquareUpperQuantile(evidence.dof, false_alarm);
-  if (!with_baseline_direction) {
-    evidence.statistic = rotation_alone;
-  } else {
-    const Eigen::Matrix<double, 3, 5> M = information.bottomRows<3>();
-    const DirectionsMatrix P = directions.transpose() * camr_covariance * directions;
-    const Eigen::Matrix3d C = H + M * P * M.transpose();
-    const Eigen::MatrixXd basis = U.leftCols(evidence.dof);
-    const Eigen::VectorXd projected = basis.transpose() * b;
-    const Eigen::MatrixXd projected_covariance = basis.transpose() * C * basis;
-    evidence.statistic = projected.dot(projected_covariance.ldlt().solve(projected));
-  }
+  evidence.statistic = rotation_alone;
   evidence.contradicts = evidence.statistic > evidence.bound;
   return evidence;
 }

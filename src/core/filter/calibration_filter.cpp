@@ -8,7 +8,6 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
-#include "online_stereo_calibration/core/filter/errors_in_variables.h"
 #include "online_stereo_calibration/core/filter/process_model.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/filter/update_tempering.h"
@@ -111,7 +110,6 @@ struct CalibrationFilter::PointInnovation {
   MatrixXd J;                       ///< 4 x G: d residual / d global error (through x_camr and B)
   Eigen::Matrix<double, 4, 3> H_p;  ///< d z / d point
   Eigen::Matrix4d S0;               ///< covariance of the residual given the global error
-  VectorXd eiv_score;               ///< G: errorsInVariablesScore, empty when not compensated
   double nis = 0.0;                 ///< full normalised innovation squared
   double nis_left = 0.0;            ///< left image only
 };
@@ -321,7 +319,6 @@ void CalibrationFilter::startCalibration(const StereoExtrinsics& guess) {
   excitation_.reset();
   monitor_.reset();
   time_since_opened_ = {0.0, 0.0};
-  floorOnThinEvidence(0, layout::kCalibrationDim);
   rejection_streak_ = 0;
   score_streak_ = 0;
   points_.clear();
@@ -442,7 +439,7 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
              : Eigen::Vector3d::Zero();
 
   // The step on a homogeneous point, for the errors x of its s inputs.
-  const HomogeneousStep step = [&](const VectorXd& x, HomogeneousPoint point_h) {
+  const auto step = [&](const VectorXd& x, HomogeneousPoint point_h) {
     const Eigen::Isometry3d T_veh_lopt =
         boxPlus(extrinsics_.T_veh_caml, x.head<6>()) * bodyFromOptical();
     Vector6d motion_error = Vector6d::Zero();
@@ -463,8 +460,6 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
     moved.w() = w;
     return moved;
   };
-  const bool compensate = config_.errors_in_variables_compensation != 0;
-  const LinearStepMap linear_step = compensate ? linearizeStep(step, s) : LinearStepMap();
 
   for (size_t i = 0; i < points_.size(); ++i) {
     TrackedPoint& point = points_[i];
@@ -493,18 +488,6 @@ void CalibrationFilter::predictPoints(const MotionIncrement& motion, const Matri
           config_.point_position_noise * std::sqrt(noiseScale(config_, motion.dt)));
     const Eigen::Matrix3d J = coordinates_.jacobianFromPosition(ut.mean) / point_scale;
     Q = J * Q * J.transpose();
-    for (MatrixXd& gradient : point.regression_gradient) gradient.resize(0, 0);
-    // Compensated: the first update of a point whose error is its own (its pixels') more than
-    // the calibration's. (Where x_camr's error dominates the stereo depth, after a start or a
-    // re-opening, E[e e^T] is not D for the update's g and compensating it moved runs 90, 92
-    // and 132 of the default campaign beyond 5 sigma.)
-    if (compensate && !point.updated &&
-        ((point.B * P * point.B.transpose()).diagonal().array() <= point.D.diagonal().array())
-            .all()) {
-      point.regression_gradient =
-          regressionGradient(coordinates_, linear_step, mean, selected, static_cast<int>(P.rows()));
-      point.own_error_cross = F_p * point.D;
-    }
     point.D = F_p * point.D * F_p.transpose() + ut.residual + Q;
     point.D = 0.5 * (point.D + point.D.transpose());
     point.B = B;
@@ -677,34 +660,11 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   double nis_sum = 0.0;
   // From a start or a re-opening far from the truth one update may not shrink a
   // calibration sigma by more than max_sigma_shrink_per_update (update_tempering.h).
-  // A point held out (informsCalibration) updates itself below, given dg, but not dg.
-  std::vector<const PointInnovation*> informing;
-  informing.reserve(used.size());
-  for (const PointInnovation* inn : used) {
-    if (informsCalibration(points_[inn->point])) informing.push_back(inn);
-  }
-  report.held_out_points = static_cast<int>(used.size() - informing.size());
   std::vector<LinearizedMeasurement> linearized;
-  linearized.reserve(informing.size());
-  for (const PointInnovation* inn : informing) linearized.push_back({&inn->J, &inn->S0});
-  // ... nor, after a start or re-opening, below its floor before enough points were
-  // measured (gated out or not: it is the amount of data that is thin, not its agreement).
-  const bool floored = (thin_evidence_floor_.array() > 0.0).any();
-  if (final_pass && floored) {
-    for (const PointInnovation& inn : innovations) {
-      thin_evidence_support_.insert(points_[inn.point].id);
-    }
-    if (static_cast<int>(thin_evidence_support_.size()) >= config_.thin_evidence_points) {
-      thin_evidence_floor_.setZero();
-      thin_evidence_support_.clear();
-    }
-  }
-  const Eigen::VectorXd floor = (thin_evidence_floor_.array() > 0.0).any()
-                                    ? Eigen::VectorXd(thin_evidence_floor_)
-                                    : Eigen::VectorXd();  // none, or released above
+  linearized.reserve(used.size());
+  for (const PointInnovation* inn : used) linearized.push_back({&inn->J, &inn->S0});
   const double tempering =
-      updateTempering(P, linearized, layout::kCalibrationDim, config_.max_sigma_shrink_per_update,
-                      floor.size() > 0 ? &floor : nullptr);
+      updateTempering(P, linearized, layout::kCalibrationDim, config_.max_sigma_shrink_per_update);
   report.tempering = tempering;
   // The update's information for the consistency monitor (consistency_monitor.h):
   // A = sum J^T S0^-1 J, b = sum J^T S0^-1 v, c = sum v^T S0^-1 v with v = r - J dg_prior.
@@ -712,20 +672,18 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   // the calibration drifts. Fed to the consistency monitor they raised x_camr's process
   // noise for tens of seconds (x_camr RMSE +15-30 % over the default campaign).
   const bool monitored =
-      final_pass && config_.consistency_window > 0.0 && !informing.empty() && tempering == 1.0;
+      final_pass && config_.consistency_window > 0.0 && !used.empty() && tempering == 1.0;
   const VectorXd dg_prior = dg;
   MatrixXd information = monitored ? MatrixXd::Zero(G, G) : MatrixXd();
   VectorXd score = monitored ? VectorXd::Zero(G) : VectorXd();
   double residual_norm = 0.0;
   MatrixXd PJt, gain;
-  VectorXd eiv_score = VectorXd::Zero(G);
-  for (size_t k = 0; k < informing.size(); ++k) {
-    const PointInnovation* inn = informing[k];
+  for (size_t k = 0; k < used.size(); ++k) {
+    const PointInnovation* inn = used[k];
     // A point whose S is indefinite is skipped here; its own update below uses S0 only.
     if (!sequentialGain(P, linearized[k], tempering, &PJt, &gain)) continue;
     dg += gain * (inn->residual - inn->J * dg);
     P.noalias() -= gain * PJt.transpose();
-    if (inn->eiv_score.size() == G) eiv_score += inn->eiv_score;
     nis_sum += inn->nis;
     if (monitored) {
       const Eigen::Matrix4d S0_inverse = inn->S0.inverse();
@@ -737,13 +695,9 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
     }
   }
   P = 0.5 * (P + P.transpose());
-  // The updates' errors-in-variables bias (errors_in_variables.h) taken back: the sequential
-  // updates equal dg = P_post (P^-1 dg_prior + sum J^T (S0 tempering)^-1 r), whose score
-  // lacks sum eiv_score / tempering in expectation.
-  if (!eiv_score.isZero()) dg.noalias() += P * eiv_score / tempering;
   if (monitored) {
     scores_ = computeUpdateScores(information, score, residual_norm, P,
-                                  layout::kMeasurementDim * static_cast<int>(informing.size()));
+                                  layout::kMeasurementDim * static_cast<int>(used.size()));
     has_scores_ = true;
   }
   *motion_error = shared ? Vector6d(dg.tail<6>()) : Vector6d::Zero();
@@ -756,7 +710,6 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
     TrackedPoint& point = points_[inn->point];
     const Eigen::Matrix<double, 3, 4> K = point.D * inn->H_p.transpose() * inn->S0.inverse();
     point.mean += K * inn->residual + (point.B - K * inn->J) * dg;
-    keepInFront(&point);
     point.B -= K * inn->J;
     point.updated = true;
     const Eigen::Matrix3d IKH = Eigen::Matrix3d::Identity() - K * inn->H_p;
@@ -925,11 +878,6 @@ bool CalibrationFilter::linearizeMeasurement(size_t i, const MatrixXd& P, const 
   inn->S0 = inn->H_p * point.D * inn->H_p.transpose() + ut.residual;
   inn->S0.diagonal() += variance;
   inn->S = inn->J * P * inn->J.transpose() + inn->S0;
-  inn->eiv_score.resize(0);
-  if (point.regression_gradient[0].cols() == P.rows()) {
-    inn->eiv_score =
-        errorsInVariablesScore(point.regression_gradient, inn->H_p, inn->S0, point.own_error_cross);
-  }
   if (z.allFinite()) {
     inn->nis = inn->residual.dot(inn->S.llt().solve(inn->residual));
     inn->nis_left = inn->residual.head<2>().dot(
@@ -1123,15 +1071,6 @@ void CalibrationFilter::widenBlock(JumpBlock block, const Vector6d& sigma) {
   covariance_.middleCols<6>(first).setZero();
   covariance_.block<6, 6>(first, first) = variance.asDiagonal();
   time_since_opened_[blockIndex(block)] = 0.0;
-  floorOnThinEvidence(first, 6);
-}
-
-void CalibrationFilter::floorOnThinEvidence(int first, int count) {
-  if (config_.thin_evidence_points <= 0) return;
-  const double shrink = config_.thin_evidence_max_shrink;
-  thin_evidence_floor_.segment(first, count) =
-      covariance_.diagonal().segment(first, count) / (shrink * shrink);
-  thin_evidence_support_.clear();
 }
 
 bool CalibrationFilter::repairCovariance() {
@@ -1221,7 +1160,6 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
   TrackedPoint point;
   point.id = m.id;
   point.mean = ut.mean.head<3>();
-  keepInFront(&point);
   point.B = MatrixXd::Zero(3, persistentDim());
   point.B.middleCols<6>(layout::kCamr) = ut.jacobian.topLeftCorner<3, 6>();
   // D = Cov(p) - B P B^T: what the calibration does not explain (pixel noise, nonlinearity).
@@ -1231,17 +1169,6 @@ bool CalibrationFilter::addPoint(const PointMeasurement& m) {
   index_[point.id] = points_.size();
   points_.push_back(std::move(point));
   return true;
-}
-
-bool CalibrationFilter::informsCalibration(const TrackedPoint& point) const {
-  if (config_.hold_out_points_beyond_infinity == 0 || !coordinates_.inverseDepth()) return true;
-  return point.mean.z() >= minInverseDepth() * pointScale();
-}
-
-void CalibrationFilter::keepInFront(TrackedPoint* point) const {
-  // (Positions: a new one's depth is checked, addPoint.)
-  if (config_.keep_points_in_front == 0 || !coordinates_.inverseDepth()) return;
-  point->mean.z() = std::max(point->mean.z(), minInverseDepth() * pointScale());
 }
 
 void CalibrationFilter::removePoint(PointId id) {

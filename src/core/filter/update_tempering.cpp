@@ -40,23 +40,16 @@ Eigen::MatrixXd updatedCovariance(const Eigen::MatrixXd& P,
 
 double updateTempering(const Eigen::MatrixXd& P,
                        const std::vector<LinearizedMeasurement>& measurements, int limited,
-                       double max_shrink, const Eigen::VectorXd* variance_floor) {
+                       double max_shrink) {
   if (measurements.empty()) return 1.0;
   limited = std::min(limited, static_cast<int>(P.rows()));
   // The largest allowed prior / posterior variance ratio of each limited component.
   Eigen::VectorXd bound = Eigen::VectorXd::Constant(
       limited,
       max_shrink > 1.0 ? max_shrink * max_shrink : std::numeric_limits<double>::infinity());
-  if (variance_floor) {
-    for (int k = 0; k < limited; ++k) {
-      if ((*variance_floor)(k) > 0.0 && P(k, k) > 0.0) {
-        bound(k) = std::min(bound(k), std::max(P(k, k) / (*variance_floor)(k), 1.0));
-      }
-    }
-  }
   if (!(bound.minCoeff() < std::numeric_limits<double>::infinity())) return 1.0;
-  // A variance at its floor may not shrink at all: the update is held back (S0 scaled so
-  // far up that it changes nothing measurable).
+  // A bound at 1 (no shrink allowed) holds the update back: S0 scaled so far up that it
+  // changes nothing measurable.
   constexpr double kHeldBack = 1e12;
   double alpha = 1.0;
   constexpr int kSteps = 4;

@@ -275,15 +275,30 @@ CampaignRanges parseCampaignRanges(const std::string& text, const std::string& s
       } else if (isDirectory(trajectories_dir)) {
         dir = trajectories_dir;
       }
+      std::string missing;
       if (dir.empty()) {
-        problems.push_back("trajectories_dir: '" + trajectories_dir +
-                           "' is not a directory (looked beside the ranges file, '" + beside +
-                           "', and in the current directory); needed by motion.kind 'recorded'");
+        missing = "trajectories_dir: '" + trajectories_dir +
+                  "' is not a directory (looked beside the ranges file, '" + beside +
+                  "', and in the current directory)";
       } else {
         ranges.trajectory_files = tumFiles(dir);
         if (ranges.trajectory_files.empty()) {
-          problems.push_back("trajectories_dir: '" + dir +
-                             "' holds no *.tum file; needed by motion.kind 'recorded'");
+          missing = "trajectories_dir: '" + dir + "' holds no *.tum file";
+        }
+      }
+      if (!missing.empty()) {
+        // Drop the kind rather than refuse the campaign: a clone without the recorded
+        // trajectories beside it still runs the drawn motions.
+        for (auto& kind_weight : ranges.motion.weights) {
+          if (kind_weight.first == "recorded") kind_weight.second = 0.0;
+        }
+        bool other = false;
+        for (const auto& kind_weight : ranges.motion.weights) other |= kind_weight.second > 0.0;
+        if (other) {
+          ranges.dropped_recorded =
+              missing + ": motion.kind 'recorded' dropped, the other motions drawn";
+        } else {
+          problems.push_back(missing + "; needed by motion.kind 'recorded', the only kind");
         }
       }
     }

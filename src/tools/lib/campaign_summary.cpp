@@ -7,6 +7,9 @@
 #include <set>
 #include <sstream>
 
+#include "online_stereo_calibration/tools/campaign_score.h"
+#include "online_stereo_calibration/tools/perfect_filter.h"
+
 namespace osc {
 
 namespace {
@@ -149,8 +152,18 @@ std::string formatCampaignSummary(const std::vector<CampaignRow>& rows, int wors
   text << "Campaign of " << n << " runs (" << ok << " ran, " << n - ok << " failed)\n"
        << "Honest (share_within_3sigma >= " << kHonestShare
        << " and frames_beyond_5sigma = 0): " << honest << " of " << n << " (" << percent(honest, n)
-       << ")\n"
-       << "Frames beyond 5 sigma: " << frames_beyond << " in " << runs_beyond << " runs; of them "
+       << ")\n";
+  if (n > 0 && rows.front().frames > kCampaignFirstScoredFrame) {
+    const PerfectFilterScore perfect = perfectFilterScore(rows.front().frames);
+    text << "A perfect filter (its errors exactly N(0, sigma), perfect_filter.h) on runs of "
+         << rows.front().frames << " frames: honest in "
+         << format("%.0f", 100.0 * perfect.honest_low) << "-"
+         << format("%.0f %%", 100.0 * perfect.honest_high)
+         << " of the runs, some frame beyond 5 sigma in "
+         << format("%.1f %%", 100.0 * perfect.beyond_5sigma) << ", mean share within 3 sigma "
+         << format("%.3f", perfect.mean_share) << ", CONVERGED frames beyond 3 sigma about 3 %\n";
+  }
+  text << "Frames beyond 5 sigma: " << frames_beyond << " in " << runs_beyond << " runs; of them "
        << frames_unseen << " in " << runs_unseen
        << " runs in an unseen change (frames_beyond_5sigma_unseen: the calibration changed in a "
           "blind stretch, nothing tracked since)\n"

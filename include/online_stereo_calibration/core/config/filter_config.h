@@ -81,26 +81,6 @@ struct FilterConfig {
   /// uncertainty stays close to Gaussian while the depth is +-100 % uncertain (a new point
   /// under a wide x_camr prior, a far point); 0: as positions (x, y, z), the seed's choice.
   int inverse_depth_points = 1;
-  /// 1: an inverse-depth point whose mean lies beyond infinity (a negative inverse depth: x_camr's
-  /// rotation guess shifts its disparity past zero) is moved to the farthest depth
-  /// (2 max_point_depth), at its initialisation and after each update; its covariance is kept.
-  /// Linearised beyond infinity the motion's parallax points the wrong way (default campaign
-  /// run 90: yaw_l 0.7 -> 6.9 sigma off on the first update of four such points). 0 (default):
-  /// kept where it lies. Measured mixed (docs/RESULTS.md "Session 36"): drawn default campaign
-  /// 153 -> 154 honest, 617 -> 573 frames beyond 5 sigma (run 91 honest), images and
-  /// paper_offroad unchanged, but the 11 cm rig guessed at 1 cm (Start.ABaselineGuessFarTooShort
-  /// IsMeasuredFromMotion) 0.78 instead of >= 0.95 of its frames within 3 sigma.
-  int keep_points_in_front = 0;
-  /// 1: an inverse-depth point beyond infinity or farther than 2 max_point_depth (its mean's
-  /// inverse depth below minInverseDepth: a wrong x_camr rotation guess shifted its disparity
-  /// past zero) informs only itself, not the calibration (a Schmidt "consider" point): it is
-  /// gated, counted in the jump test and updated given the calibration's correction, but its
-  /// innovation does not move the calibration, the tempering or the consistency monitor
-  /// until its mean is back in front. Linearised beyond infinity its parallax points the wrong
-  /// way (default campaign run 90: yaw_l 6.9 sigma off after four such points); moving it to
-  /// the farthest depth (keep_points_in_front) instead distorts what it says about x_camr.
-  /// 0: every gated point informs the calibration. Measured in docs/RESULTS.md "Session 38".
-  int hold_out_points_beyond_infinity = 0;
   /// 1: points are stored in units of the baseline (the left-to-right camera distance |t_r|):
   /// a point p is kept as p / |t_r|, which is what a stereo pair measures. Two images of a
   /// static scene then say nothing about the baseline, exactly and at any linearisation
@@ -115,16 +95,6 @@ struct FilterConfig {
   /// points the metric filter would reject (docs/RESULTS.md "Points in units of the
   /// baseline").
   int baseline_scaled_points = 1;
-  /// Compensate the update for the errors in its variables (errors_in_variables.h): a
-  /// point's regression on the global error, evaluated at its noisy stereo depth, shrinks the
-  /// camera's translation measured through it by E[sigma_rho^2] / E[rho^2] (the baseline long,
-  /// the lever arm of a sideways camera off). Off by default: measured (docs/RESULTS.md
-  /// "Session 33") it removes that bias on a weak-stereo rig whose odometry's scale is exact
-  /// (honest runs 10 -> 17 of 20, the baseline's mean error -1.39 -> +0.15 of its sigma), but
-  /// the default campaign lost 2 of 166 honest runs and KITTI's seq2 yaw_l went 3.2 sigma off
-  /// for some frames: turn it on for a small baseline with a calibrated odometry scale
-  /// (odometry_scale_sigma_percent: 0).
-  int errors_in_variables_compensation = 0;
 
   // --- input sanity ---
   double max_speed = 70.0;          ///< m/s; a motion increment faster than this is rejected
@@ -183,15 +153,6 @@ struct FilterConfig {
   /// kept, instead of re-opening was worse: yaw_r, which one pair hardly shows, then locked
   /// 12-14 sigma off after real knocks (runs 62, 139).
   int epipolar_knock_pairs = 1;
-  /// 1: the epipolar knock test allows for the spread of x_camr's baseline direction too (it
-  /// also tilts the lines; epipolar_consistency.h), and a knock it finds re-opens x_camr's
-  /// translation across the baseline with the rotation (to the baseline's length times the
-  /// rotation's re-opening). 0: the rotation's covariance alone, the translation kept.
-  /// Off by default: it ends default campaign run 92's false knock (a start's baseline 5 deg
-  /// off taken for one: 164 frames beyond 5 sigma -> 0), but at image level it also hides
-  /// start alarms whose stereo-fit re-seed helped (image run 15: 0 -> 94 frames); measured
-  /// mixed over five benches (docs/RESULTS.md "Session 35").
-  int epipolar_knock_baseline_direction = 0;
 
   // --- re-linearisation after a start or a re-opening (issue 14) ---
   /// Every this many frames after a start (or a re-opened block), the estimator compares the
@@ -234,17 +195,6 @@ struct FilterConfig {
   /// the default campaign (200 runs, docs/RESULTS.md "Session 15"): 112 -> 123 honest runs,
   /// frames beyond 5 sigma 4101 -> 2566, RMSE unchanged or better.
   double max_sigma_shrink_per_update = 3.0;
-  /// No collapse on thin evidence (issue 14): until this many distinct points have been
-  /// measured (predicted and compared, whether used or gated out) since a start or a block's
-  /// re-opening, none of the started (re-opened) sigmas falls below its start value /
-  /// thin_evidence_max_shrink (the update is tempered, update_tempering.h; one at its floor
-  /// holds the update back). 0 = off, the default: 20 made the default campaign's run 24
-  /// honest (x_camr 4.7 deg off, one point: yaw_r 7 sigma wrong for 435 frames without) and
-  /// gave 139 instead of 134 honest runs, but at image level it held back the first updates
-  /// of starts far off that see only 2-6 points per frame, and 4 of 20 image runs became
-  /// 114-170 frames beyond 5 sigma; 5 changed nothing (docs/RESULTS.md "Session 17").
-  int thin_evidence_points = 0;
-  double thin_evidence_max_shrink = 3.0;
   /// A pair with fewer stereo pairs than this, tracked and new together (a texture-poor view,
   /// a dim image, blur), does not update the calibration (issue 14: "keep the estimate, do not
   /// update, report too few points and wait"): the filter only predicts, and its tracked
@@ -261,17 +211,6 @@ struct FilterConfig {
   /// odometry's scale (baseline_from_motion.h) and restart x_camr's translation from it
   /// (issue 14: "a guess 50 % off must converge"). 0 = off (the paper).
   int baseline_from_motion = 1;
-  /// With baseline_from_motion, while not one point can be initialised and the baseline's
-  /// length is known (its sigma below 30 % of it): x_camr's rotation is
-  /// what keeps the pairs out (yaw_r guessed 4.7 deg off on a 0.26 m rig put every pair beyond
-  /// infinity: no point for 15 s, then yr 16 sigma off; default campaign run 24). 1: x_camr is
-  /// turned by the disparity offset measured with the length (at most
-  /// max_disparity_offset_turn), its covariance kept. 0: wait (the stereo fit or the scene may
-  /// let points in). Measured in docs/RESULTS.md "Session 38".
-  int disparity_offset_turn = 0;
-  /// The largest turn disparity_offset_turn makes: beyond it the disparity model's fit is not
-  /// honest (yaw_r 20 deg off: turned 23.4 deg at 1 sigma 0.08 deg).
-  double max_disparity_offset_turn = 10.0 * 0.0174532925199432958;  ///< rad
 
   // --- the odometry's own errors as states (issue 15; process_model.h correctedMotion) ---
   /// Prior mean (s) of the camera-odometry time offset d: the camera clock minus the

@@ -8,16 +8,13 @@
 /// the old x_camr; default campaign run 102 then blamed x_caml and kept yaw_r 193 sigma off).
 ///
 /// The test: each pair's algebraic epipolar residual r_i = x_r^T F x_l, normalised by its
-/// pixel noise, is linear in x_camr's error d: its rotation and its baseline's direction
-/// (r_i = a_i^T d + n_i; the baseline's length does not enter). The rotation's score
-/// b = sum a_theta r has the covariance C = H + M P M^T if x_camr is within its covariance P
-/// (H = sum a_theta a_theta^T, M = sum a_theta a^T), so T = b_U^T (U^T C U)^-1 b_U is
-/// chi-square with rank(H) degrees of freedom over the rotations U the pairs inform (2: the
-/// rotation that slides pixels along the lines, yaw_r of a horizontal rig, does not enter).
-/// With the translation taken as exact (the default; FilterConfig::
-/// epipolar_knock_baseline_direction 0) C is H + H P_theta H; the baseline direction's share
-/// keeps an uncertain one (a start) from being taken for a knock. Pairs far off (mismatches)
-/// are down-weighted (Huber) so that one does not decide.
+/// pixel noise, is linear in x_camr's rotation error d (r_i = a_i^T d + n_i; the baseline's
+/// length does not enter, and its direction is taken as exact). The rotation's score
+/// b = sum a r has the covariance S = H + H P_theta H if x_camr is within its covariance
+/// (H = sum a a^T), so T = b^T S^+ b is chi-square with rank(H) degrees of freedom over the
+/// rotations the pairs inform (2: the rotation that slides pixels along the lines, yaw_r of
+/// a horizontal rig, does not enter). Pairs far off (mismatches) are down-weighted (Huber)
+/// so that one does not decide.
 #pragma once
 
 #include <string>
@@ -50,12 +47,11 @@ struct EpipolarEvidence {
 /// epipolar geometry of @p extrinsics' x_camr, which has the tangent covariance
 /// @p camr_covariance ([dt (m), dtheta (rad)] of T_caml_camr, the filter's block). The
 /// indicated rotation is the pairs' fit with the translation held. Fewer than @p min_pairs
-/// usable pairs never contradict. Without @p with_baseline_direction C is H + H P_theta H:
-/// the translation taken as exact (FilterConfig::epipolar_knock_baseline_direction 0).
+/// usable pairs never contradict.
 EpipolarEvidence testEpipolarLines(const std::vector<PointMeasurement>& pairs,
                                    const Eigen::Matrix3d& K_left, const Eigen::Matrix3d& K_right,
                                    const StereoExtrinsics& extrinsics,
                                    const Matrix6d& camr_covariance, double false_alarm,
-                                   int min_pairs, bool with_baseline_direction = false);
+                                   int min_pairs);
 
 }  // namespace osc

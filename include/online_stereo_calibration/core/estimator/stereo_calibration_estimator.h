@@ -118,14 +118,8 @@ class StereoCalibrationEstimator {
   std::vector<PointId> resetTracking();
   /// The right camera was knocked (CalibrationPipeline): x_camr's rotation uncertainty is
   /// re-opened to at least `rotation_sigma` (rad) and every point is forgotten. Its translation
-  /// is kept (a knock turns a camera), widened to at least `across_baseline_sigma` (m) across
-  /// the baseline only: epipolar lines tilted by the rotation could also be tilted by the
-  /// baseline's direction. Returns the forgotten points.
-  std::vector<PointId> reopenRightCameraRotation(double rotation_sigma,
-                                                 double across_baseline_sigma = 0.0);
-  /// x_camr turned by the disparity offset @p length measured from the left camera's motion
-  /// (the length known, the rotation what keeps every point out), covariance kept.
-  bool turnRightCameraByDisparityOffset(const BaselineLength& length, FrameReport* report);
+  /// is kept (a knock turns a camera). Returns the forgotten points.
+  std::vector<PointId> reopenRightCameraRotation(double rotation_sigma);
   /// The current x_camr turned about its centre so that the disparity offset @p offset (rad,
   /// BaselineLength::offset) vanishes (withoutDisparityOffset), in the body frames.
   Eigen::Isometry3d rightCameraTurnedByDisparityOffset(double offset) const;

@@ -19,7 +19,6 @@
 #include <memory>
 #include <string>
 #include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 #include <Eigen/Core>
@@ -73,11 +72,9 @@ inline Vector6d uniformBlockSigmas(double translation_sigma, double rotation_sig
 
 /// What one filter step did.
 struct StepReport {
-  bool accepted = false;      ///< false: the input was rejected and nothing changed
-  std::string message;        ///< why it was rejected, or notes
-  int measurements_used = 0;  ///< points that updated the filter
-  /// Of those, points that updated only themselves (FilterConfig::hold_out_points_beyond_infinity)
-  int held_out_points = 0;
+  bool accepted = false;              ///< false: the input was rejected and nothing changed
+  std::string message;                ///< why it was rejected, or notes
+  int measurements_used = 0;          ///< points that updated the filter
   int invalid_measurements = 0;       ///< non-finite or non-positive-variance measurements ignored
   std::vector<PointId> outliers;      ///< gated out (Mahalanobis) and removed
   std::vector<PointId> lost;          ///< not measured (or unpredictable) and removed
@@ -187,10 +184,6 @@ class CalibrationFilter {
     Eigen::MatrixXd B;                               ///< 3 x G regression on the global error
     Eigen::Matrix3d D = Eigen::Matrix3d::Zero();
     bool updated = false;  ///< has had a Kalman update
-    /// This step's errors-in-variables terms (errors_in_variables.h) of a point before its
-    /// first update: d B / d p_k and F_p D; empty when it is not compensated.
-    std::array<Eigen::MatrixXd, 3> regression_gradient;
-    Eigen::Matrix3d own_error_cross = Eigen::Matrix3d::Zero();
   };
   struct PointInnovation;  // defined in the .cpp
   struct Prediction;       // defined in the .cpp
@@ -199,15 +192,6 @@ class CalibrationFilter {
   /// The inverse depth (1/m) below which a point is placed, where a position is needed (its
   /// process noise, points()): half that of the farthest new point.
   double minInverseDepth() const { return 0.5 / config_.max_point_depth; }
-  /// With FilterConfig::keep_points_in_front: moves an inverse-depth point's mean that lies
-  /// beyond infinity (a negative inverse depth) or farther than 2 max_point_depth to that depth
-  /// (minInverseDepth); its covariance is kept. Such a mean is in front of the camera within
-  /// its uncertainty, but linearised there the motion's parallax points the wrong way. At the
-  /// farthest depth it tells the camera's rotation only, until its parallax tells its depth.
-  void keepInFront(TrackedPoint* point) const;
-  /// False for a point held out by FilterConfig::hold_out_points_beyond_infinity: an
-  /// inverse-depth mean beyond infinity or farther than 2 max_point_depth (minInverseDepth).
-  bool informsCalibration(const TrackedPoint& point) const;
   /// The length a stored point is measured in (FilterConfig::baseline_scaled_points): the
   /// baseline |t_r| of @p T_caml_camr, or 1 (metres) for metric points.
   double pointScale(const Eigen::Isometry3d& T_caml_camr) const {
@@ -302,14 +286,6 @@ class CalibrationFilter {
   int rejection_streak_ = 0;
   /// Updates in a row whose x_camr score statistic was beyond its bound.
   int score_streak_ = 0;
-  /// No collapse on thin evidence (FilterConfig::thin_evidence_points): the variance floors
-  /// of the calibration components started or re-opened (0: none), and the points measured
-  /// since; the floors go when there are enough of them.
-  Vector12d thin_evidence_floor_ = Vector12d::Zero();
-  std::unordered_set<PointId> thin_evidence_support_;
-  /// Floors calibration components [first, first + count) at their variance now / the
-  /// configured shrink squared, and starts counting support afresh.
-  void floorOnThinEvidence(int first, int count);
   PointCoordinates coordinates_;  ///< how TrackedPoint::mean stores a point
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;

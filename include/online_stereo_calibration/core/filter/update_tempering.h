@@ -37,13 +37,11 @@ bool sequentialGain(const Eigen::MatrixXd& P, const LinearizedMeasurement& measu
 
 /// The factor alpha >= 1 for S0 such that the update of prior covariance @p P with
 /// @p measurements shrinks none of the first @p limited standard deviations by more than
-/// @p max_shrink (the sequential update the filter applies, S = J P J^T + alpha S0), nor
-/// any variance k below @p variance_floor(k) if given (size >= limited; 0: no floor; a
-/// variance already at its floor is held there, which holds back the whole update). 1 when
-/// neither binds (max_shrink <= 1 is off). Found by a few fixed-point steps on alpha (exact
+/// @p max_shrink (the sequential update the filter applies, S = J P J^T + alpha S0). 1 when
+/// that does not bind (max_shrink <= 1 is off). Found by a few fixed-point steps on alpha (exact
 /// for one state dimension, slightly above the bound for correlated ones).
 double updateTempering(const Eigen::MatrixXd& P,
                        const std::vector<LinearizedMeasurement>& measurements, int limited,
-                       double max_shrink, const Eigen::VectorXd* variance_floor = nullptr);
+                       double max_shrink);
 
 }  // namespace osc
