@@ -1,0 +1,254 @@
+#!/usr/bin/python3
+"""Markdown tables of docs/RESULTS.md from the outputs of scripts/results.sh.
+
+  results_tables.py rmse DIR [DIR ...] [--window FIRST LAST]
+      Pooled RMSE per parameter over the window's frames of every run directory (each with
+      estimates.csv and reference.csv, as calibrate_simulation writes them), beside the
+      paper's Table I; angles wrapped to +-180 deg.
+  results_tables.py kitti LOG
+      The last printed frame of each KITTI sequence of test_kitti's diagnostic, as a table.
+  results_tables.py splice DOC DIR --stamp TEXT
+      Puts each DIR/NAME.md into DOC between its <!-- results:NAME --> markers.
+  results_tables.py ablation DIR VARIANT [VARIANT ...]
+      scripts/ablation.sh's table: per variant (DIR/VARIANT/{drawn,phase0,po}) the campaigns'
+      honest runs and frames beyond 5 sigma and paper_offroad's RMSE relative to `shipped`.
+  results_tables.py campaign DIR [--perfect-runs N]
+      A campaign's honesty (campaign.csv) beside what a perfectly consistent filter scores on
+      the same number of frames (scripts/honest_by_chance.py's models).
+
+The campaign table's columns: honest runs (all 12 errors within 3 sigma in >= 95 % of the
+frames from frame 30 on and none beyond 5 sigma), runs with a frame beyond 5 sigma, those
+frames (of them in an unseen change: a knock inside a blind stretch, nothing tracked since),
+the mean share of frames within 3 sigma, and CONVERGED frames with some error beyond 3 sigma.
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+
+import numpy as np
+
+import honest_by_chance
+
+NAMES = ["xl", "yl", "zl", "roll_l", "pitch_l", "yaw_l",
+         "xr", "yr", "zr", "roll_r", "pitch_r", "yaw_r"]
+ANGLE = [False] * 3 + [True] * 3 + [False] * 3 + [True] * 3
+# Mueller & Wuensche 2016, Table I: RMSE (m, deg); the same values as
+# src/tools/lib/evaluation.cpp paperTableRmse().
+PAPER_RMSE = [0.0608, 0.0382, 0.0132, 0.2995, 0.7061, 0.2844,
+              0.0044, 0.0048, 0.0037, 0.0236, 0.0174, 0.0193]
+
+
+def read_frames(path):
+    with open(path) as f:
+        return {int(row["frame"]): row for row in csv.DictReader(f)}
+
+
+def pooled_rmse(directories, first, last):
+    """Per parameter (m, rad) over the window's frames of every run directory."""
+    squares = np.zeros(12)
+    count = 0
+    for directory in directories:
+        estimates = read_frames(os.path.join(directory, "estimates.csv"))
+        reference = read_frames(os.path.join(directory, "reference.csv"))
+        for frame in range(first, last + 1):
+            if frame not in estimates or frame not in reference:
+                sys.exit("results_tables: %s has no frame %d in estimates.csv and reference.csv"
+                         % (directory, frame))
+            for k, name in enumerate(NAMES):
+                error = float(estimates[frame][name]) - float(reference[frame][name])
+                if ANGLE[k]:
+                    error = math.remainder(error, 2.0 * math.pi)
+                squares[k] += error * error
+            count += 1
+    return np.sqrt(squares / count)
+
+
+def rmse_table(directories, first, last):
+    rmse = pooled_rmse(directories, first, last)
+    units = ["mm" if not a else "deg" for a in ANGLE]
+    head = "| | " + " | ".join("%s %s" % (n, u) for n, u in zip(NAMES, units)) + " |"
+    print(head)
+    print("|---|" + "---:|" * 12)
+
+    def cells(values):
+        out = []
+        for k, v in enumerate(values):
+            out.append("%.4f" % v if ANGLE[k] else "%.2f" % (v * 1e3))
+        return " | ".join(out)
+
+    ours = [rmse[k] * (180.0 / math.pi if ANGLE[k] else 1.0) for k in range(12)]
+    print("| ours, %d runs x frames %d-%d | %s |" % (len(directories), first, last, cells(ours)))
+    print("| paper, Table I | %s |" % cells(PAPER_RMSE))
+    ratio = " | ".join("%.2f" % (ours[k] / PAPER_RMSE[k]) for k in range(12))
+    print("| ours / paper | %s |" % ratio)
+
+
+def campaign_counts(directory):
+    """(honest runs, runs, frames beyond 5 sigma) of a campaign directory."""
+    with open(os.path.join(directory, "campaign.csv")) as f:
+        rows = list(csv.DictReader(f))
+    honest = sum(1 for r in rows if r["status"] == "ok" and float(r["share_within_3sigma"]) >= 0.95
+                 and int(r["frames_beyond_5sigma"]) == 0)
+    beyond = sum(int(r["frames_beyond_5sigma"]) for r in rows if r["status"] == "ok")
+    return honest, len(rows), beyond
+
+
+def ablation_table(directory, variants, first=1000, last=1150):
+    """One row per variant of scripts/ablation.sh; RMSE relative to `shipped`."""
+    def seeds(variant):
+        root = os.path.join(directory, variant, "po")
+        return [os.path.join(root, d) for d in sorted(os.listdir(root))]
+
+    shipped = pooled_rmse(seeds("shipped"), first, last)
+    print("| switched off | drawn: honest / frames > 5σ | phase-0: honest / frames > 5σ "
+          "| paper_offroad RMSE / shipped: largest (parameter) | pitch_l |")
+    print("|---|---|---|---|---|")
+    for variant in variants:
+        cells = []
+        for campaign in ("drawn", "phase0"):
+            honest, runs, beyond = campaign_counts(os.path.join(directory, variant, campaign))
+            cells.append("%d of %d / %d" % (honest, runs, beyond))
+        ratio = pooled_rmse(seeds(variant), first, last) / shipped
+        largest = int(np.argmax(np.abs(np.log(ratio))))
+        label = {"shipped": "nothing (shipped)",
+                 "noise": "nothing, runs from seed 1001 (noise)"}.get(variant, variant)
+        print("| %s | %s | %s | %.2f (%s) | %.2f |" % (label, cells[0], cells[1], ratio[largest],
+                                                      NAMES[largest], ratio[4]))
+
+
+def campaign_table(directory, perfect_runs):
+    with open(os.path.join(directory, "campaign.csv")) as f:
+        rows = list(csv.DictReader(f))
+    ok = [r for r in rows if r["status"] == "ok"]
+    if not ok:
+        sys.exit("results_tables: %s has no run that ran" % directory)
+    frames = int(ok[0]["frames"])
+    share = np.array([float(r["share_within_3sigma"]) for r in ok])
+    beyond = np.array([int(r["frames_beyond_5sigma"]) for r in ok])
+    unseen = np.array([int(r["frames_beyond_5sigma_unseen"]) for r in ok])
+    converged = sum(int(r["frames_converged"]) for r in ok)
+    converged_off = sum(int(r["frames_converged_beyond_3sigma"]) for r in ok)
+    honest = int(np.sum((share >= 0.95) & (beyond == 0)))
+    n = len(rows)
+
+    rng = np.random.default_rng(1)
+    perfect = []
+    for model in ["constant", 30.0, 100.0, 300.0]:
+        if model == "constant":
+            z = honest_by_chance.constant_model(rng, perfect_runs, frames)
+        else:
+            z = honest_by_chance.ar_model(rng, perfect_runs, frames, model)
+        p_share, p_max = honest_by_chance.scores(z)
+        perfect.append((np.mean((p_share >= 0.95) & (p_max <= 5.0)), np.mean(p_max > 5.0),
+                        p_share.mean()))
+    lo = min(p[0] for p in perfect)
+    hi = max(p[0] for p in perfect)
+    print("| %d runs x %d frames | honest | runs beyond 5σ | frames beyond 5σ (unseen) "
+          "| mean share within 3σ | CONVERGED frames beyond 3σ |" % (n, frames))
+    print("|---|---|---|---|---|---|")
+    print("| this estimator | %d of %d (%.1f %%) | %d (%.1f %%) | %d (%d) | %.3f | %d of %d (%.1f %%) |"
+          % (honest, n, 100.0 * honest / n, int(np.sum(beyond > 0)), 100.0 * np.mean(beyond > 0),
+             int(beyond.sum()), int(unseen.sum()), share.mean(), converged_off, converged,
+             100.0 * converged_off / max(converged, 1)))
+    print("| a perfect filter | %.0f-%.0f %% | %.1f %% | - | %.3f | ~3 %% |"
+          % (100.0 * lo, 100.0 * hi, 100.0 * max(p[1] for p in perfect),
+             np.mean([p[2] for p in perfect])))
+    failed = n - len(ok)
+    if failed:
+        print("\n%d runs failed (status in campaign.csv)." % failed)
+
+
+def kitti_table(log):
+    """The last printed frame of each sequence of Kitti.DISABLED_Diagnostic's printout: error
+    (1 sigma) against KITTI's calibration, as test_kitti prints them (m, deg, ms)."""
+    import re
+    last = {}
+    for line in open(log):
+        if re.match(r"^seq[12] ", line):
+            last[line.split()[0]] = line
+    if not last:
+        sys.exit("results_tables: %s holds no 'seqN' line of the KITTI diagnostic" % log)
+    number = r"([+-][0-9.]+)\(([0-9.]+)\)"
+
+    def value(line, name):
+        m = re.search(name + " " + number, line)
+        return (float(m.group(1)), float(m.group(2))) if m else (float("nan"), float("nan"))
+
+    print("| frame %s, error (1σ) | yr | roll_r | pitch_r | yaw_r | xl, yl, zl m | pitch_l | yaw_l "
+          "| time offset |" % next(iter(last.values())).split()[1])
+    print("|---|---|---|---|---|---|---|---|---|")
+    for seq in sorted(last):
+        line = last[seq]
+        yr = value(line, "yr")
+        angles = ["%+.3f° (%.3f)" % value(line, n) for n in ("roll_r", "pitch_r", "yaw_r")]
+        xyz = ", ".join("%+.2f (%.2f)" % value(line, n) for n in ("xl", "yl", "zl"))
+        left = ["%+.3f° (%.3f)" % value(line, n) for n in ("pitch_l", "yaw_l")]
+        dt = value(line, "dt")
+        print("| %s | %+.1f mm (%.1f) | %s | %s | %s | %+.1f ms (%.1f) |"
+              % (seq, 1e3 * yr[0], 1e3 * yr[1], " | ".join(angles), xyz, " | ".join(left),
+                 dt[0], dt[1]))
+
+
+def splice(document, directory, stamp):
+    """Replaces the text between each <!-- results:NAME --> and <!-- /results:NAME --> of
+    @p document with DIRECTORY/NAME.md, under a line saying where it was measured."""
+    with open(document) as f:
+        text = f.read()
+    replaced = []
+    for name in sorted(os.listdir(directory)):
+        if not name.endswith(".md"):
+            continue
+        key = name[:-3]
+        begin, end = "<!-- results:%s -->" % key, "<!-- /results:%s -->" % key
+        if begin not in text or end not in text:
+            continue
+        with open(os.path.join(directory, name)) as f:
+            table = f.read().strip()
+        head, rest = text.split(begin, 1)
+        _, tail = rest.split(end, 1)
+        text = "%s%s\n%s\n\n%s\n%s%s" % (head, begin, stamp, table, end, tail)
+        replaced.append(key)
+    if not replaced:
+        sys.exit("results_tables: no table of %s has a marker in %s" % (directory, document))
+    tmp = document + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, document)
+    print("results_tables: replaced %s in %s" % (", ".join(replaced), document))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    rmse = sub.add_parser("rmse")
+    rmse.add_argument("directories", nargs="+")
+    rmse.add_argument("--window", type=int, nargs=2, default=[1000, 1150])
+    camp = sub.add_parser("campaign")
+    camp.add_argument("directory")
+    camp.add_argument("--perfect-runs", type=int, default=2000)
+    kit = sub.add_parser("kitti")
+    kit.add_argument("log")
+    spl = sub.add_parser("splice")
+    spl.add_argument("document")
+    spl.add_argument("directory")
+    spl.add_argument("--stamp", required=True, help="the line above each table")
+    abl = sub.add_parser("ablation")
+    abl.add_argument("directory")
+    abl.add_argument("variants", nargs="+")
+    args = parser.parse_args()
+    if args.command == "rmse":
+        rmse_table(args.directories, args.window[0], args.window[1])
+    elif args.command == "kitti":
+        kitti_table(args.log)
+    elif args.command == "splice":
+        splice(args.document, args.directory, args.stamp)
+    elif args.command == "ablation":
+        ablation_table(args.directory, args.variants)
+    else:
+        campaign_table(args.directory, args.perfect_runs)
+
+
+if __name__ == "__main__":
+    main()
