@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include "temp_dir.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "online_stereo_calibration/core/estimator/stereo_calibration_estimator.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
@@ -26,6 +28,7 @@
 #include "online_stereo_calibration/tools/campaign_score.h"
 #include "online_stereo_calibration/tools/campaign_summary.h"
 #include "online_stereo_calibration/tools/estimates_csv.h"
+#include "online_stereo_calibration/tools/output_directory.h"
 #include "online_stereo_calibration/tools/perfect_filter.h"
 #include "online_stereo_calibration/tools/tum_trajectory.h"
 
@@ -1258,6 +1261,51 @@ TEST(Campaign, ReplayOfARunGivesItsRowAndPerFrameFiles) {
   // A replay with other inputs is refused.
   EXPECT_THROW(replayCampaignRun(inputsFor(kNoRecorded, 100, 21), dir.path(), 1, false),
                std::runtime_error);
+}
+
+// DIR/inputs/config.yaml is compared by its keys and values, not its text: a campaign stored
+// before config/default.yaml's layout grouped the keys in sections (other order, other
+// comments) resumes with the same configuration, and one with another value is refused.
+TEST(Campaign, StoredConfigIsComparedByKeysAndValues) {
+  TempDir dir;
+  const CampaignInputs inputs = inputsFor(kNoRecorded, 100, 3);
+  storeOrCheckCampaignInputs(dir.path(), inputs);
+  const std::string path = dir.path() + "/inputs/config.yaml";
+  // The same lines without comments, the top-level keys sorted, the front end's map last in
+  // reverse order.
+  std::vector<std::string> top, front_end;
+  std::istringstream lines(readTextFile(path));
+  for (std::string line; std::getline(lines, line);) {
+    const size_t first = line.find_first_not_of(' ');
+    if (first == std::string::npos || line[first] == '#' || line == "front_end:") continue;
+    (first == 0 ? top : front_end).push_back(line);
+  }
+  ASSERT_GT(top.size(), 50u);
+  ASSERT_GT(front_end.size(), 30u);
+  std::sort(top.begin(), top.end());
+  std::reverse(front_end.begin(), front_end.end());
+  std::string relaid;
+  for (const std::string& line : top) relaid += line + "\n";
+  relaid += "front_end:\n";
+  for (const std::string& line : front_end) relaid += line + "\n";
+  writeTextFileAtomic(path, relaid);
+  EXPECT_NO_THROW(storeOrCheckCampaignInputs(dir.path(), inputs));
+
+  for (const std::string& changed :
+       {std::string("max_points: 150\n"), std::string("  max_features: 2000\n")}) {
+    std::string other = relaid;
+    const size_t at = other.find(changed);
+    ASSERT_NE(at, std::string::npos) << changed;
+    other.insert(at + changed.size() - 1, "1");
+    writeTextFileAtomic(path, other);
+    try {
+      storeOrCheckCampaignInputs(dir.path(), inputs);
+      ADD_FAILURE() << "a stored configuration with another value was accepted: " << changed;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("the estimator configuration"), std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 TEST(Campaign, SameSeedGivesTheSameRows) {

@@ -1,7 +1,11 @@
-// Config files: the shipped YAMLs equal the code's defaults, and bad files are refused with
-// the key named.
+// Config files: the shipped YAMLs equal the code's defaults, list every key once in its
+// section (a user's keys first), and bad files are refused with the key named.
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -55,6 +59,139 @@ TEST(FilterConfigYaml, ShippedDefaultFileReadsBackToTheBuiltInDefaultsExactly) {
   }
 }
 
+// ... and the paper's file to paperFilterConfig(), and both files' front_end: maps to the
+// built-in FrontEndConfig, bit for bit.
+TEST(FilterConfigYaml, ShippedFilesReadBackExactlyWithTheirFrontEnd) {
+  EstimatorConfig paper;
+  paper.filter = paperFilterConfig();
+  const std::vector<std::pair<std::string, EstimatorConfig>> files = {
+      {"/config/default.yaml", EstimatorConfig()}, {"/config/paper.yaml", paper}};
+  for (const auto& [file, expected] : files) {
+    const EstimatorConfig read = readEstimatorConfigFile(std::string(OSC_SOURCE_DIR) + file);
+    EXPECT_EQ(read.filter.motion_noise_model, expected.filter.motion_noise_model) << file;
+    for (const ParameterSpec& spec : filterParameterTable()) {
+      if (spec.real_field) {
+        EXPECT_EQ(read.filter.*spec.real_field, expected.filter.*spec.real_field)
+            << file << " " << spec.name;
+      } else {
+        EXPECT_EQ(read.filter.*spec.integer_field, expected.filter.*spec.integer_field)
+            << file << " " << spec.name;
+      }
+    }
+    for (const FrontEndParameterSpec& spec : frontEndParameterTable()) {
+      EXPECT_EQ(spec.format(read.front_end), spec.format(expected.front_end))
+          << file << " " << spec.name;
+      if (spec.real_field) {
+        EXPECT_EQ(read.front_end.*spec.real_field, expected.front_end.*spec.real_field)
+            << file << " " << spec.name;
+      }
+    }
+  }
+}
+
+// Every key has a section (the component that uses it) that the files list, and every section
+// holds a key: a key without one would be left out of the generated files.
+TEST(ConfigSections, EveryKeyHasAListedSection) {
+  std::set<std::string> filter_sections;
+  for (const ParameterSection& section : filterParameterSections()) {
+    EXPECT_TRUE(filter_sections.insert(section.name).second) << section.name;
+    EXPECT_FALSE(section.description.empty()) << section.name;
+  }
+  std::set<std::string> used = {kMotionNoiseModelSection};
+  EXPECT_TRUE(filter_sections.count(kMotionNoiseModelSection));
+  for (const ParameterSpec& spec : filterParameterTable()) {
+    EXPECT_TRUE(filter_sections.count(spec.section)) << spec.name << ": '" << spec.section << "'";
+    used.insert(spec.section);
+  }
+  EXPECT_EQ(used, filter_sections);
+
+  std::set<std::string> front_end_sections;
+  for (const ParameterSection& section : frontEndParameterSections()) {
+    EXPECT_TRUE(front_end_sections.insert(section.name).second) << section.name;
+    EXPECT_FALSE(section.description.empty()) << section.name;
+  }
+  used.clear();
+  for (const FrontEndParameterSpec& spec : frontEndParameterTable()) {
+    EXPECT_TRUE(front_end_sections.count(spec.section))
+        << spec.name << ": '" << spec.section << "'";
+    used.insert(spec.section);
+  }
+  EXPECT_EQ(used, front_end_sections);
+
+  // A table whose row names no listed section is refused naming the key.
+  std::vector<ParameterSpec> table = filterParameterTable();
+  table[3].section = "nowhere";
+  try {
+    requireKnownSections(table, filterParameterSections(), "t");
+    ADD_FAILURE() << "a key without a listed section must be refused";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find(table[3].name), std::string::npos) << e.what();
+  }
+}
+
+// Issue "One estimator a newcomer can read", step 4: at most ~60 keys a user has to read.
+TEST(ConfigSections, UserFacingKeysAreFew) {
+  int user = kMotionNoiseModelAdvanced ? 0 : 1;
+  int advanced = kMotionNoiseModelAdvanced ? 1 : 0;
+  for (const ParameterSpec& spec : filterParameterTable()) (spec.advanced ? advanced : user)++;
+  for (const FrontEndParameterSpec& spec : frontEndParameterTable()) {
+    (spec.advanced ? advanced : user)++;
+  }
+  EXPECT_LE(user, 60);
+  EXPECT_GT(user, 0);
+  EXPECT_EQ(user + advanced,
+            static_cast<int>(filterParameterTable().size() + frontEndParameterTable().size()) + 1);
+}
+
+// The generated file lists each key once: the user's keys, then the advanced banner, then the
+// advanced keys (the front end's inside its map, indented; the filter's at the top level).
+TEST(ConfigSections, ShippedFileListsUserKeysBeforeTheAdvancedPart) {
+  const std::string file = readText(std::string(OSC_SOURCE_DIR) + "/config/default.yaml");
+  const size_t banner = file.find("\n# ADVANCED: ");
+  ASSERT_NE(banner, std::string::npos);
+  EXPECT_EQ(file.find("\n# ADVANCED: ", banner + 1), std::string::npos);
+  const auto position = [&](const std::string& line) {
+    const size_t at = file.find("\n" + line);
+    EXPECT_NE(at, std::string::npos) << line;
+    EXPECT_EQ(file.find("\n" + line, at + 1), std::string::npos) << line << " twice";
+    return at;
+  };
+  const auto expectPart = [&](const std::string& line, bool advanced) {
+    if (advanced) {
+      EXPECT_GT(position(line), banner) << line << " is advanced";
+    } else {
+      EXPECT_LT(position(line), banner) << line << " is a user's key";
+    }
+  };
+  expectPart("motion_noise_model: ", kMotionNoiseModelAdvanced);
+  for (const ParameterSpec& spec : filterParameterTable()) {
+    expectPart(spec.name + ": ", spec.advanced);
+  }
+  for (const FrontEndParameterSpec& spec : frontEndParameterTable()) {
+    expectPart("  " + spec.name + ": ", spec.advanced);
+  }
+  for (const ParameterSection& section : filterParameterSections()) {
+    EXPECT_NE(file.find("# ==== " + section.name), std::string::npos) << section.name;
+  }
+  for (const ParameterSection& section : frontEndParameterSections()) {
+    EXPECT_NE(file.find("  # ==== front_end: " + section.name), std::string::npos) << section.name;
+  }
+}
+
+// docs/configuration.md's tables list every key a user may set.
+TEST(ConfigSections, UserGuideNamesEveryUserKey) {
+  const std::string guide = readText(std::string(OSC_SOURCE_DIR) + "/docs/configuration.md");
+  ASSERT_FALSE(guide.empty());
+  for (const ParameterSpec& spec : filterParameterTable()) {
+    if (spec.advanced) continue;
+    EXPECT_NE(guide.find("| `" + spec.name + "` |"), std::string::npos) << spec.name;
+  }
+  for (const FrontEndParameterSpec& spec : frontEndParameterTable()) {
+    if (spec.advanced) continue;
+    EXPECT_NE(guide.find("| `" + spec.name + "` |"), std::string::npos) << spec.name;
+  }
+}
+
 TEST(FilterConfigYaml, PaperFileHoldsThePapersNumbers) {
   const std::string text = readText(std::string(OSC_SOURCE_DIR) + "/config/paper.yaml");
   EXPECT_NE(text.find("point_position_noise_m: 0.2\n"), std::string::npos);      // eq. 14
@@ -76,6 +213,19 @@ TEST(FilterConfigYaml, PartialFileKeepsOtherDefaults) {
   const FilterConfig c = parseFilterConfigYaml("pixel_noise_px: 1.5\n", "partial");
   EXPECT_DOUBLE_EQ(c.pixel_noise, 1.5);
   EXPECT_DOUBLE_EQ(c.outlier_gate, FilterConfig().outlier_gate);
+}
+
+TEST(FilterConfigYaml, EveryKeyOutOfRangeIsAnErrorNamingIt) {
+  for (const ParameterSpec& spec : filterParameterTable()) {
+    std::ostringstream text;
+    text << spec.name << ": " << spec.min_value - 1.0 << "\n";
+    try {
+      parseEstimatorConfigYaml(text.str(), "low.yaml");
+      ADD_FAILURE() << spec.name << " below its range was accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(spec.name + " = "), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(FilterConfigYaml, BadFilesNameEveryProblem) {

@@ -38,11 +38,15 @@ EstimatorConfig readEstimatorConfigFile(const std::string& path,
                                         const EstimatorConfig& base = EstimatorConfig());
 
 /// The `front_end:` section of a loadable file: every key of frontEndParameterTable() with
-/// its value, each after a comment with its meaning and allowed range.
+/// its value, each after a comment with its meaning and allowed range; the user's keys by
+/// section (frontEndParameterSections()), then the advanced ones by section.
 std::string formatFrontEndConfigYaml(const FrontEndConfig& config);
 
-/// A whole loadable file: formatFilterConfigYaml(config.filter, title) followed by the
-/// `front_end:` section (what write_default_configs writes to config/default.yaml).
+/// A whole loadable file (what write_default_configs writes to config/default.yaml): a
+/// header; the filter's user keys by section; the `front_end:` map with its user keys; then
+/// one advanced part: the front end's advanced keys (closing its map), the filter's advanced
+/// keys by section. The same keys and values as formatFilterConfigYaml(config.filter, title)
+/// plus formatFrontEndConfigYaml(config.front_end).
 std::string formatEstimatorConfigYaml(const EstimatorConfig& config, const std::string& title);
 
 }  // namespace osc

@@ -16,9 +16,12 @@ FilterConfig parseFilterConfigYaml(const std::string& text, const std::string& s
                                    const FilterConfig& base = FilterConfig());
 
 /// Reads a YAML file (see parseFilterConfigYaml). Throws std::runtime_error naming the file.
-FilterConfig readFilterConfigFile(const std::string& path, const FilterConfig& base = FilterConfig());
+FilterConfig readFilterConfigFile(const std::string& path,
+                                  const FilterConfig& base = FilterConfig());
 
-/// Every key with its value and its doc line as a comment: a complete, loadable file.
+/// Every key with its value and its doc line as a comment: a complete, loadable file. A
+/// header, then the user's keys (ParameterSpec::advanced false) section by section
+/// (filterParameterSections()), then the advanced part, also by section.
 std::string formatFilterConfigYaml(const FilterConfig& config, const std::string& title);
 
 }  // namespace osc

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <yaml-cpp/yaml.h>
 #include <opencv2/core/utility.hpp>
 
 #include "online_stereo_calibration/core/sim/image_scenario_runner.h"
@@ -27,6 +28,9 @@ namespace {
 
 /// The status of a run whose process died (killed, crashed) starts so; such runs are retried.
 const std::string kProcessFailure = "failed: process ";
+
+/// The title of DIR/inputs/config.yaml.
+constexpr const char* kConfigTitle = "estimator configuration of the campaign";
 
 bool exists(const std::string& path) {
   struct stat st;
@@ -135,10 +139,42 @@ CampaignRow runCampaignRun(const CampaignRunSpec& spec, const EstimatorConfig& c
   return row;
 }
 
+namespace {
+
+/// A configuration file's keys and values as written ("front_end.KEY" for its map's).
+std::map<std::string, std::string> configScalars(const std::string& text) {
+  std::map<std::string, std::string> scalars;
+  const YAML::Node root = YAML::Load(text);
+  for (const auto& entry : root) {
+    const std::string key = entry.first.as<std::string>();
+    if (!entry.second.IsMap()) {
+      scalars[key] = entry.second.Scalar();
+      continue;
+    }
+    for (const auto& inner : entry.second) {
+      scalars[key + "." + inner.first.as<std::string>()] = inner.second.Scalar();
+    }
+  }
+  return scalars;
+}
+
+/// Whether a stored DIR/inputs/config.yaml holds what @p config_text holds: the same keys
+/// with the same values as written, in any order and with any comments, so that a file of an
+/// older layout of formatEstimatorConfigYaml (the keys not yet grouped in sections) matches.
+bool sameConfigFile(const std::string& stored, const std::string& config_text) {
+  if (stored == config_text) return true;
+  try {
+    return configScalars(stored) == configScalars(config_text);
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 void storeOrCheckCampaignInputs(const std::string& dir, const CampaignInputs& inputs) {
   const std::string in = dir + "/inputs";
-  const std::string config_text =
-      formatEstimatorConfigYaml(inputs.config, "estimator configuration of the campaign");
+  const std::string config_text = formatEstimatorConfigYaml(inputs.config, kConfigTitle);
   const std::string campaign_text = inputsText(inputs);
   if (!exists(in + "/campaign.txt")) {
     makeDirectories(in);
@@ -156,7 +192,7 @@ void storeOrCheckCampaignInputs(const std::string& dir, const CampaignInputs& in
   if (readTextFile(in + "/ranges.yaml") != inputs.ranges_text) {
     differences.push_back("the ranges (compare with " + in + "/ranges.yaml)");
   }
-  if (readTextFile(in + "/config.yaml") != config_text) {
+  if (!sameConfigFile(readTextFile(in + "/config.yaml"), config_text)) {
     differences.push_back("the estimator configuration --config (compare with " + in +
                           "/config.yaml)");
   }

@@ -90,23 +90,58 @@ EstimatorConfig readEstimatorConfigFile(const std::string& path, const Estimator
   return parseEstimatorConfigYaml(text.str(), path, base);
 }
 
-std::string formatFrontEndConfigYaml(const FrontEndConfig& config) {
+namespace {
+
+/// The front end's keys whose `advanced` is @p advanced, indented for the `front_end:` map,
+/// section by section in frontEndParameterSections() order, each after a comment with its
+/// meaning and allowed range.
+std::string formatFrontEndKeys(const FrontEndConfig& config, bool advanced) {
+  const std::string indent = "  ";
   std::ostringstream out;
-  out << "# The image front end (osc::FrontEndConfig; the nodelet reads ~front_end/<key>).\n"
-      << kFrontEndSection << ":\n";
-  bool first = true;
-  for (const FrontEndParameterSpec& spec : frontEndParameterTable()) {
-    if (!first) out << "\n";
-    first = false;
-    out << "  # " << spec.doc << " " << spec.allowedText() << "\n"
-        << "  " << spec.name << ": " << spec.format(config) << "\n";
+  for (const ParameterSection& section : frontEndParameterSections()) {
+    std::ostringstream keys;
+    for (const FrontEndParameterSpec& spec : frontEndParameterTable()) {
+      if (spec.section != section.name || spec.advanced != advanced) continue;
+      keys << "\n"
+           << detail::commentLines(spec.doc, indent, spec.allowedText()) << indent << spec.name
+           << ": " << spec.format(config) << "\n";
+    }
+    if (keys.str().empty()) continue;
+    out << "\n"
+        << detail::sectionBanner(
+               {std::string(kFrontEndSection) + ": " + section.name, section.description}, indent,
+               advanced)
+        << keys.str();
   }
   return out.str();
 }
 
+/// The map's opening: its banner and `front_end:`.
+std::string frontEndMapOpening() {
+  return detail::sectionBanner({"image front end (front_end:)",
+                                "the image front end (osc::FrontEndConfig; the nodelet reads "
+                                "~front_end/<key>): features, stereo matches and tracks"},
+                               "", false) +
+         kFrontEndSection + ":\n";
+}
+
+}  // namespace
+
+std::string formatFrontEndConfigYaml(const FrontEndConfig& config) {
+  return frontEndMapOpening() + formatFrontEndKeys(config, false) + "\n" +
+         detail::commentLines(
+             "ADVANCED front-end keys: change one only with a measurement (docs/RESULTS.md).",
+             "  ") +
+         formatFrontEndKeys(config, true);
+}
+
 std::string formatEstimatorConfigYaml(const EstimatorConfig& config, const std::string& title) {
-  return formatFilterConfigYaml(config.filter, title) + "\n" +
-         formatFrontEndConfigYaml(config.front_end);
+  // The user's keys (the filter's, then the front end's), then one advanced part: the front
+  // end's advanced keys close its map, the filter's follow at the top level.
+  return detail::formatConfigHeader(title) + detail::formatFilterKeys(config.filter, false) + "\n" +
+         frontEndMapOpening() + formatFrontEndKeys(config.front_end, false) + "\n" +
+         detail::advancedBanner() + formatFrontEndKeys(config.front_end, true) +
+         detail::formatFilterKeys(config.filter, true);
 }
 
 }  // namespace osc

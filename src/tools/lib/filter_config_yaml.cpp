@@ -99,20 +99,92 @@ std::string formatFileValue(const ParameterSpec& spec, const FilterConfig& confi
 
 }  // namespace
 
-std::string formatFilterConfigYaml(const FilterConfig& config, const std::string& title) {
+namespace detail {
+
+std::string commentLines(const std::string& text, const std::string& indent,
+                         const std::string& tail) {
+  constexpr size_t kWidth = 100;
+  const std::string prefix = indent + "#";
+  std::vector<std::string> words;
+  std::istringstream in(text);
+  for (std::string word; in >> word;) words.push_back(word);
+  if (!tail.empty()) words.push_back(tail);
   std::ostringstream out;
-  out << "# " << title << "\n"
-      << "# Every parameter of the estimator; the unit is the key's suffix (_m, _deg, _s, _px).\n"
-      << "# Per-step noise sigmas refer to reference_period_s and scale with sqrt(dt / it).\n\n"
-      << "# per_point: the seed's eq. 15-27 (independent per point, overconfident);\n"
-      << "# shared: one 6-DoF motion error per step shared by all points (ours).\n"
-      << "motion_noise_model: " << motionNoiseModelName(config.motion_noise_model) << "\n";
-  for (const ParameterSpec& spec : filterParameterTable()) {
-    out << "\n# " << spec.doc << " [" << std::setprecision(12) << spec.min_value << ", "
-        << spec.max_value << "]\n"
-        << spec.name << ": " << formatFileValue(spec, config) << "\n";
+  std::string line = prefix;
+  for (const std::string& word : words) {
+    if (line.size() > prefix.size() && line.size() + 1 + word.size() > kWidth) {
+      out << line << "\n";
+      line = prefix;
+    }
+    line += " " + word;
+  }
+  out << line << "\n";
+  return out.str();
+}
+
+std::string formatConfigHeader(const std::string& title) {
+  return "# " + title + "\n" +
+         commentLines(
+             "The keys are grouped by the component that uses them: first the keys a user may "
+             "set for a new rig, odometry or lens, then the advanced part (thresholds tuned on "
+             "measurements). docs/configuration.md says which keys to touch. The unit is the "
+             "key's suffix (_m, _deg, _s, _ms, _px, _mps, _dps, _percent). A file given with "
+             "--config needs only the keys it changes (the nodelet reads the same keys as private "
+             "parameters, ~key and ~front_end/key); an unknown key, or a value outside the range "
+             "after its comment, is an error naming the key.",
+             "");
+}
+
+std::string sectionBanner(const ParameterSection& section, const std::string& indent,
+                          bool advanced) {
+  return indent + "# ==== " + section.name + (advanced ? " (advanced)" : "") + " ====\n" +
+         commentLines(section.description, indent);
+}
+
+std::string advancedBanner() {
+  const std::string rule = "# " + std::string(78, '#') + "\n";
+  return rule +
+         commentLines(
+             "ADVANCED: thresholds tuned by the developers on the benches of docs/RESULTS.md. "
+             "Change one only with a measurement (docs/RESULTS.md). In a file with the front "
+             "end, its advanced keys come first, still inside the front_end: map (indented); "
+             "the filter's follow at the top level.",
+             "") +
+         rule;
+}
+
+std::string formatFilterKeys(const FilterConfig& config, bool advanced) {
+  std::ostringstream out;
+  for (const ParameterSection& section : filterParameterSections()) {
+    std::ostringstream keys;
+    if (section.name == kMotionNoiseModelSection && advanced == kMotionNoiseModelAdvanced) {
+      keys << "\n"
+           << commentLines(
+                  "how the odometry's error enters the points' prediction: per_point is the "
+                  "seed's eq. 15-27 (an independent error per point: overconfident), shared: one "
+                  "6-DoF error per step shared by all points (ours)",
+                  "", "{per_point, shared}")
+           << "motion_noise_model: " << motionNoiseModelName(config.motion_noise_model) << "\n";
+    }
+    for (const ParameterSpec& spec : filterParameterTable()) {
+      if (spec.section != section.name || spec.advanced != advanced) continue;
+      std::ostringstream range;
+      range << std::setprecision(12) << "[" << spec.min_value << ", " << spec.max_value << "]";
+      keys << "\n"
+           << commentLines(spec.doc, "", range.str()) << spec.name << ": "
+           << formatFileValue(spec, config) << "\n";
+    }
+    if (keys.str().empty()) continue;
+    out << "\n" << sectionBanner(section, "", advanced) << keys.str();
   }
   return out.str();
+}
+
+}  // namespace detail
+
+std::string formatFilterConfigYaml(const FilterConfig& config, const std::string& title) {
+  return detail::formatConfigHeader(title) + detail::formatFilterKeys(config, false) + "\n" +
+         detail::advancedBanner() + detail::formatFilterKeys(config, true);
 }
 
 }  // namespace osc

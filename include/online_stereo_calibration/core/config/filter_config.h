@@ -1,11 +1,14 @@
 /// @file filter_config.h
 /// @brief Every tunable of the estimator in one struct, with one table that names each
-/// parameter, its unit, its allowed range and its meaning. The YAML loader, the ROS
-/// parameter loader and validate() all read that table, so a name exists once.
+/// parameter, its unit, its allowed range, its meaning, its section and whether a user sets
+/// it. The YAML loader, the ROS parameter loader, validate() and the generated
+/// config/default.yaml all read that table, so a name exists once.
 #pragma once
 
 #include <string>
 #include <vector>
+
+#include "online_stereo_calibration/core/config/parameter_section.h"
 
 namespace osc {
 
@@ -376,6 +379,12 @@ struct ParameterSpec {
   bool is_integer = false;
   double FilterConfig::*real_field = nullptr;
   int FilterConfig::*integer_field = nullptr;
+  /// The component that uses the key: the name of one of filterParameterSections().
+  std::string section;
+  /// false: a key a user may need to set for a new rig, odometry or lens (noise, priors,
+  /// what is estimated); true: an internal threshold tuned on measurements, listed in the
+  /// files' advanced part (change it only with a measurement: docs/RESULTS.md).
+  bool advanced = false;
 
   /// Value in file units.
   double get(const FilterConfig& config) const;
@@ -386,6 +395,15 @@ struct ParameterSpec {
 /// The table: every numeric parameter of FilterConfig (motion_noise_model is the one
 /// non-numeric key, see motionNoiseModelFromName).
 const std::vector<ParameterSpec>& filterParameterTable();
+
+/// The sections of the filter's keys, in the order config/default.yaml lists them; every
+/// ParameterSpec::section names one of them.
+const std::vector<ParameterSection>& filterParameterSections();
+
+/// motion_noise_model, the one non-numeric key, sits in this section, as an advanced key
+/// (per_point is the seed's model, kept to reproduce it).
+constexpr const char* kMotionNoiseModelSection = "rig and noise";
+constexpr bool kMotionNoiseModelAdvanced = true;
 
 /// "per_point" | "shared"; @throws std::invalid_argument naming the allowed values.
 MotionNoiseModel motionNoiseModelFromName(const std::string& name);

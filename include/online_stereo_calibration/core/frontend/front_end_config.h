@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "online_stereo_calibration/core/config/parameter_section.h"
+
 namespace osc {
 
 /// The front end's configuration. Units: px, degrees where the name says `_deg`.
@@ -156,6 +158,11 @@ struct FrontEndParameterSpec {
   int FrontEndConfig::*integer_field = nullptr;
   double FrontEndConfig::*real_field = nullptr;
   bool FrontEndConfig::*bool_field = nullptr;
+  /// The part of the front end that uses the key: one of frontEndParameterSections().
+  std::string section;
+  /// false: a key a user may need for a new camera or scene; true: an internal threshold
+  /// tuned on measurements (the files list it after the user's keys).
+  bool advanced = false;
 
   bool isNumber() const { return type == Type::kInteger || type == Type::kReal; }
   /// Integer and real fields: the value (bool: 0 / 1).
@@ -180,5 +187,9 @@ struct FrontEndParameterSpec {
 
 /// Every field of FrontEndConfig, in declaration order.
 const std::vector<FrontEndParameterSpec>& frontEndParameterTable();
+
+/// The sections of the front end's keys, in the order config/default.yaml lists them; every
+/// FrontEndParameterSpec::section names one of them.
+const std::vector<ParameterSection>& frontEndParameterSections();
 
 }  // namespace osc
