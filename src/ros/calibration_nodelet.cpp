@@ -454,8 +454,7 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
         warning.rfind("mounting rotation from motion", 0) == 0) {
       diagnostics_->recordProblem("mounting rotation from motion", warning);
     }
-    if (result.estimator.step.right_rotation_widened &&
-        warning.rfind("x_camr's rotation", 0) == 0) {
+    if (result.estimator.right_rotation_widened && warning.rfind("x_camr's rotation", 0) == 0) {
       diagnostics_->recordProblem("right camera rotation contradicted", warning);
     }
     if (result.estimator.right_camera_off_epipolar_lines &&
@@ -490,7 +489,7 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
   }
   // A change found by the filter's jump test, or by the pipeline (a knocked right camera).
   const bool jump = result.estimator.step.jump != osc::JumpBlock::kNone ||
-                    result.estimator.step.right_rotation_widened || result.right_camera_reopened;
+                    result.estimator.right_rotation_widened || result.right_camera_reopened;
   const uint8_t state = calibrationState(result.estimate, jump, config_.ros.min_tracked_points,
                                          config_.ros.converged);
   StereoCalibration message =

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Cholesky>
 
+#include "online_stereo_calibration/core/estimator/right_camera_score_test.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
 #include "online_stereo_calibration/core/filter/dense_calibration_ukf.h"
 #include "online_stereo_calibration/core/filter/point_coordinates.h"
@@ -526,6 +527,58 @@ TEST(CalibrationFilter, ALeftCameraYawStepIsFittedAndOnlyTheTurnedAxisReopened) 
   EXPECT_NEAR(report.jump_sigma(5), std::sqrt(P(5, 5)), 1e-12);
   EXPECT_NE(report.message.find("rotation fitted to 40 of 40 points"), std::string::npos)
       << report.message;
+}
+
+/// Steps a filter converged at the truth over frames 1-3, then turns the right camera by
+/// @p pitch_r before frame 4 and steps frames 4-7 with the score test after each step without
+/// a jump; the frame at which the test widened x_camr's rotation (-1: never) and x_camr's
+/// pitch sigma then.
+int scoreTestAfterAKnock(double pitch_r, double* sigma_after, bool* jumped) {
+  SmallProblem problem(40, 8);
+  CalibrationFilter filter(FilterConfig(), problem.K);
+  RightCameraScoreTest test(RightCameraScoreOptions::from(FilterConfig()));
+  Vector12d sigma;
+  sigma << 0.01, 0.01, 0.01, 0.1 * kDeg, 0.1 * kDeg, 0.1 * kDeg, 0.005, 0.005, 0.005, 0.05 * kDeg,
+      0.05 * kDeg, 0.05 * kDeg;
+  filter.reset(problem.truth, sigma.array().square().matrix().asDiagonal());
+  for (const PointMeasurement& m : problem.measure(0, 0.3)) filter.addPoint(m);
+  *jumped = false;
+  for (int k = 1; k < 8; ++k) {
+    if (k == 4) {
+      problem.truth.T_caml_camr.linear() =
+          problem.truth.T_caml_camr.linear() * rotationFromRpy(Eigen::Vector3d(0, pitch_r, 0));
+    }
+    const StepReport step = filter.step(problem.motion(k), problem.measure(k, 0.3));
+    EXPECT_TRUE(step.accepted);
+    if (step.jump != JumpBlock::kNone) {
+      *jumped = true;
+      return -1;
+    }
+    const ScoreWidening widening = test.afterStep(&filter);
+    if (widening.widened) {
+      EXPECT_NE(widening.warning.find("x_camr's rotation contradicted by 2 updates in a row"),
+                std::string::npos)
+          << widening.warning;
+      *sigma_after = std::sqrt(filter.covariance()(10, 10));
+      return k;
+    }
+  }
+  *sigma_after = std::sqrt(filter.covariance()(10, 10));
+  return -1;
+}
+
+// A knock of the right camera too small to gate out a point (pitch_r 0.1 deg: 1 px against
+// 0.3 px of noise and 0.05 deg of sigma) is caught by x_camr's score in its second update,
+// and its rotation sigma widened beyond the knock; without a knock it never is.
+TEST(RightCameraScoreTest, ASmallKnockWidensTheRightRotationInTwoUpdates) {
+  double sigma = 0.0;
+  bool jumped = false;
+  EXPECT_EQ(scoreTestAfterAKnock(0.1 * kDeg, &sigma, &jumped), 5);
+  EXPECT_FALSE(jumped);
+  EXPECT_GT(sigma, 0.1 * kDeg);
+  EXPECT_EQ(scoreTestAfterAKnock(0.0, &sigma, &jumped), -1);
+  EXPECT_FALSE(jumped);
+  EXPECT_LT(sigma, 0.06 * kDeg);
 }
 
 TEST(CalibrationFilter, WithoutTheRotationFitALeftCameraJumpReopensEveryAxisInPlace) {

@@ -60,114 +60,22 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
       left_(left),
       right_(right),
       filter_(config, stereoIntrinsics(left_, right_)),
+      restart_(RestartFromEstimateOptions::from(config)),
+      score_test_(RightCameraScoreOptions::from(config)),
       guess_(initial_guess),
       mounting_(left_, handEyeConfig(config)),
       baseline_from_motion_(baselineConfig(config, left_)) {
   filter_.reset(initial_guess);
   guess_covariance_ = filter_.covariance();
-  anchorHere(JumpBlock::kNone, Vector6d::Zero());
+  restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
 }
 
-void StereoCalibrationEstimator::anchorHere(JumpBlock block, const Vector6d& reopened_sigma) {
-  anchor_ = LinearizationAnchor();
-  anchor_.extrinsics = filter_.extrinsics();
-  anchor_.covariance = filter_.covariance();
-  anchor_.blocks = {{block != JumpBlock::kLeftToRight, block != JumpBlock::kVehicleToLeft}};
-  anchor_.reopened_sigma = reopened_sigma;
-}
-
-void StereoCalibrationEstimator::anchorReopening(JumpBlock block, const Vector6d& reopened_sigma) {
-  const bool start_is_live = anchorIsLive() && anchor_.blocks[0] && anchor_.blocks[1];
-  if (!start_is_live) anchorHere(block, reopened_sigma);
-}
-
-double StereoCalibrationEstimator::movedSinceAnchor(int block) const {
-  if (!anchor_.blocks[static_cast<size_t>(block)]) return 0.0;
-  const StereoExtrinsics& now = filter_.extrinsics();
-  const Vector6d moved = block == 0 ? boxMinus(now.T_veh_caml, anchor_.extrinsics.T_veh_caml)
-                                    : boxMinus(now.T_caml_camr, anchor_.extrinsics.T_caml_camr);
-  // After a start every component is checked; after a re-opening only those re-opened (a
-  // rotation-only re-opening keeps the block's converged translation, whose small sigma any
-  // ordinary update moves it by).
-  const bool whole_start = anchor_.blocks[0] && anchor_.blocks[1];
-  double largest = 0.0;
-  for (int k = 0; k < 6; ++k) {
-    const double variance = anchor_.covariance(6 * block + k, 6 * block + k);
-    if (!(variance > 0.0) || (!whole_start && !(anchor_.reopened_sigma(k) > 0.0))) continue;
-    largest = std::max(largest, std::abs(moved(k)) / std::sqrt(variance));
-  }
-  return largest;
-}
-
-bool StereoCalibrationEstimator::anchorIsLive() const {
-  return config_.relinearization_frames > 0 && anchor_.restarts < config_.max_relinearizations &&
-         anchor_.steps < (config_.max_relinearizations + 1) * config_.relinearization_frames;
-}
-
-bool StereoCalibrationEstimator::relinearizeIfMoved(FrameReport* report) {
-  if (!anchorIsLive()) return false;
-  ++anchor_.steps;
-  anchor_.nis_sum += report->step.mean_nis * report->step.measurements_used;
-  anchor_.nis_count += report->step.measurements_used;
-  if (++anchor_.frames < config_.relinearization_frames) return false;
-  // A move alone is what any start within its prior does as it converges (the largest of 12
-  // components is often 1-2 sigmas); a linearisation far off also shows in the innovations:
-  // measured mean NIS per stereo measurement over frames 1-15, 4 dof: 3.7-4.0 from a good
-  // guess, 4.5-6.5 from the paper's start errors, 8-9.5 with x_camr's angles 3-5 deg off.
-  const double nis_per_dof =
-      anchor_.nis_count > 0 ? anchor_.nis_sum / (4.0 * anchor_.nis_count) : 0.0;
-  anchor_.frames = 0;
-  anchor_.nis_sum = 0.0;
-  anchor_.nis_count = 0;
-  const std::array<double, 2> moved = {movedSinceAnchor(0), movedSinceAnchor(1)};
-  // A block that moved far from the guess lowers the innovation gate for both: the points of
-  // either were linearised at the far-off start. After a first restart the estimate is the
-  // linearisation point, and a further far move is convergence from it (a sideways camera
-  // guessed forward, restarted again at frame 31: xl 3-3.3 sigma off for 30 frames).
-  const bool far = config_.relinearization_far_threshold > 0.0 && anchor_.restarts == 0 &&
-                   std::max(moved[0], moved[1]) > config_.relinearization_far_threshold;
-  if (!(nis_per_dof > (far ? config_.relinearization_far_nis : config_.relinearization_nis)))
-    return false;
-  const std::array<bool, 2> restart = {moved[0] > config_.relinearization_threshold,
-                                       moved[1] > config_.relinearization_threshold};
-  if (!restart[0] && !restart[1]) return false;
-  // Restart at the current estimate: the points were initialised and the first updates
-  // linearised at a calibration now known to be far off, so their regressions on it (and
-  // the sigma they gave) do not hold. The moved block's uncertainty at the anchor comes back
-  // (the other block keeps what it learned), and the data shrink it again from a
-  // linearisation point near the truth.
-  // The odometry states (time offset, velocity bias, x_camr's drift rate) keep what they
-  // learned: a reset threw away, e.g., default campaign run 25's time offset (19.3 +- 0.5 ms
-  // -> 0 +- 20 ms at a restart in frame 30).
-  for (const PointEstimate& p : filter_.points()) report->dropped.push_back(p.id);
-  const bool whole_start = anchor_.blocks[0] && anchor_.blocks[1];
-  if (whole_start && restart[0] && restart[1]) {
-    filter_.restartCalibration(anchor_.covariance);
-  } else {
-    for (int block = 0; block < 2; ++block) {
-      if (!restart[static_cast<size_t>(block)]) continue;
-      Vector6d sigma = anchor_.reopened_sigma;
-      if (whole_start) {  // the start's own sigmas of this block
-        const Vector6d variance = anchor_.covariance.diagonal().segment<6>(6 * block);
-        sigma = uniformBlockSigmas(std::sqrt(variance.head<3>().maxCoeff()),
-                                   std::sqrt(variance.tail<3>().maxCoeff()));
-      }
-      filter_.reopen(block == 0 ? JumpBlock::kVehicleToLeft : JumpBlock::kLeftToRight, sigma);
-    }
-  }
-  anchor_.extrinsics = filter_.extrinsics();
-  ++anchor_.restarts;
+bool StereoCalibrationEstimator::restartIfLinearizedFarOff(FrameReport* report) {
+  const RestartDecision decision = restart_.checkAfterStep(&filter_, report->step);
+  if (!decision.restarted) return false;
+  report->dropped.insert(report->dropped.end(), decision.dropped.begin(), decision.dropped.end());
   report->relinearized = true;
-  std::ostringstream message;
-  message << "restarted from the current estimate (re-linearised): "
-          << (restart[0] && restart[1] ? "x_caml and x_camr"
-              : restart[0]             ? "x_caml"
-                                       : "x_camr")
-          << " moved " << std::max(restart[0] ? moved[0] : 0.0, restart[1] ? moved[1] : 0.0)
-          << " start sigmas from where the filter was started, innovations at " << nis_per_dof
-          << " of their expected size (restart " << anchor_.restarts << " of at most "
-          << config_.max_relinearizations << "); tracks reset";
-  report->warnings.push_back(message.str());
+  report->warnings.push_back(decision.warning);
   return true;
 }
 
@@ -205,7 +113,7 @@ bool StereoCalibrationEstimator::restartFromMotion(
   covariance.template block<3, 3>(kCaml + kRotation, kCaml + kRotation) = restart.covariance;
   filter_.reset(start, covariance);
   // A start: both blocks re-linearised as after one.
-  anchorHere(JumpBlock::kNone, Vector6d::Zero());
+  restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
   report->mounting_rotation_from_motion = true;
   const Eigen::Vector3d before = rpyFromRotation(now.T_veh_caml.linear()) * 180.0 / M_PI;
   const Eigen::Vector3d after = rpyFromRotation(restart.R_veh_caml) * 180.0 / M_PI;
@@ -324,18 +232,22 @@ FrameReport StereoCalibrationEstimator::processFrame(
                             report.step.outliers.end());
       // Not a re-opening: the points stay, and the re-linearisation check below counts the
       // frame as any other.
-      if (report.step.right_rotation_widened) report.warnings.push_back(report.step.message);
+      if (report.step.jump == JumpBlock::kNone) {
+        const ScoreWidening widening = score_test_.afterStep(&filter_);
+        report.right_rotation_widened = widening.widened;
+        if (widening.widened) report.warnings.push_back(widening.warning);
+      }
       if (report.step.jump != JumpBlock::kNone) {
         report.warnings.push_back(report.step.message);
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());
-        anchorReopening(report.step.jump, report.step.jump_sigma);
+        restart_.anchorReopening(filter_, report.step.jump, report.step.jump_sigma);
         // x_caml was re-opened on its own evidence: the check after a stretch without points
         // has its answer (left armed, it could re-open the axes a fitted turn kept to
         // jump_rotation_sigma_deg on the next frames' transient).
         if (report.step.jump == JumpBlock::kVehicleToLeft) gap_check_left_ = 0.0;
       } else if (reopenLeftCameraAfterGap(motion, &report)) {
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());
-      } else if (relinearizeIfMoved(&report)) {
+      } else if (restartIfLinearizedFarOff(&report)) {
         // Tracking starts afresh with the next pair, as after a start.
         candidates.clear();
         has_previous_frame_ = false;
@@ -560,7 +472,7 @@ bool StereoCalibrationEstimator::reopenLeftCameraAfterGap(const MotionIncrement&
       uniformBlockSigmas(config_.jump_translation_sigma, config_.jump_rotation_sigma);
   const std::vector<PointId> dropped = filter_.reopen(JumpBlock::kVehicleToLeft, sigma);
   report->dropped.insert(report->dropped.end(), dropped.begin(), dropped.end());
-  anchorReopening(JumpBlock::kVehicleToLeft, sigma);
+  restart_.anchorReopening(filter_, JumpBlock::kVehicleToLeft, sigma);
   report->left_camera_reopened_after_gap = true;
   std::ostringstream message;
   message << "x_caml re-opened: the updates after a stretch without points disagree with it "
@@ -584,7 +496,7 @@ std::vector<PointId> StereoCalibrationEstimator::reopenRightCameraRotation(doubl
   has_previous_frame_ = false;
   const Vector6d sigma = uniformBlockSigmas(0.0, rotation_sigma);
   std::vector<PointId> dropped = filter_.reopen(JumpBlock::kLeftToRight, sigma);
-  anchorReopening(JumpBlock::kLeftToRight, sigma);
+  restart_.anchorReopening(filter_, JumpBlock::kLeftToRight, sigma);
   return dropped;
 }
 
@@ -622,11 +534,12 @@ std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
   has_previous_frame_ = false;
   mounting_.forgetFrame();
   if (start) {
-    anchorHere(JumpBlock::kNone, Vector6d::Zero());
+    restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
   } else {
-    anchorReopening(JumpBlock::kLeftToRight,
-                    uniformBlockSigmas(std::sqrt(covariance.diagonal().head<3>().maxCoeff()),
-                                       std::sqrt(covariance.diagonal().tail<3>().maxCoeff())));
+    restart_.anchorReopening(
+        filter_, JumpBlock::kLeftToRight,
+        uniformBlockSigmas(std::sqrt(covariance.diagonal().head<3>().maxCoeff()),
+                           std::sqrt(covariance.diagonal().tail<3>().maxCoeff())));
   }
   return dropped;
 }
@@ -672,7 +585,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
   filter_.reset(guess);
   guess_covariance_ = filter_.covariance();
   has_previous_frame_ = false;
-  anchorHere(JumpBlock::kNone, Vector6d::Zero());
+  restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
 }
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
@@ -690,7 +603,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
                            : Matrix12d(0.5 * (internal + internal.transpose())));
   guess_covariance_ = filter_.covariance();
   has_previous_frame_ = false;
-  anchorHere(JumpBlock::kNone, Vector6d::Zero());
+  restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
 }
 
 Matrix12d StereoCalibrationEstimator::odometryScaleCovariance(

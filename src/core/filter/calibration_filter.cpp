@@ -320,7 +320,7 @@ void CalibrationFilter::startCalibration(const StereoExtrinsics& guess) {
   monitor_.reset();
   time_since_opened_ = {0.0, 0.0};
   rejection_streak_ = 0;
-  score_streak_ = 0;
+  ++starts_;
   points_.clear();
   index_.clear();
 }
@@ -539,7 +539,6 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
   previous_motions_.push_back(motion);
   if (static_cast<int>(previous_motions_.size()) > kTwistTrendIncrements)
     previous_motions_.erase(previous_motions_.begin());
-  if (report.jump == JumpBlock::kNone) widenRightRotationOnEvidence(&report);
   if (report.jump != JumpBlock::kNone) monitor_.clearWindow();  // the evidence was the jump's
   monitor_.addUpdate(motion.dt, has_scores_ ? &scores_ : nullptr);
   report.consistency = monitor_.status();
@@ -934,38 +933,10 @@ void CalibrationFilter::marginalizeMotionError(const MatrixXd& P) {
   covariance_ = P_cc;
 }
 
-void CalibrationFilter::widenRightRotationOnEvidence(StepReport* report) {
-  if (!(config_.jump_score_false_alarm > 0.0) || !has_scores_) {
-    score_streak_ = 0;
-    return;
-  }
-  std::array<double, 2> statistic;
-  std::array<int, 2> dof;
-  calibrationStatistics(scores_.score, scores_.information, &statistic, &dof);
-  const int right = static_cast<int>(ConsistencyBlock::kLeftToRight);
-  // A common excess of every measurement (noise under-estimated) is not x_camr's (the
-  // monitor's F test).
-  const double common = std::max(1.0, scores_.rest / std::max(1, scores_.rest_dof));
-  const bool contradicted =
-      dof[right] > 0 && statistic[right] / common >
-                            chiSquareUpperQuantile(dof[right], config_.jump_score_false_alarm);
-  score_streak_ = contradicted ? score_streak_ + 1 : 0;
-  if (score_streak_ < config_.jump_score_updates || !canReopen(JumpBlock::kLeftToRight)) return;
-  score_streak_ = 0;
-  // The rotation the updates indicate; its translation is left: one update determines x_camr's
-  // translation poorly (its estimate was centimetres off in a 0.15 deg roll knock).
-  const Vector6d shift =
-      partialShiftEstimate(scores_.score, scores_.information, ConsistencyBlock::kLeftToRight);
-  const Eigen::Vector3d rotation = shift.segment<3>(layout::kRotation);
-  covariance_.diagonal().segment<3>(layout::kCamr + layout::kRotation) +=
-      (config_.jump_score_widening * rotation).array().square().matrix();
-  report->right_rotation_widened = true;
-  std::ostringstream message;
-  message << "x_camr's rotation contradicted by " << config_.jump_score_updates
-          << " updates in a row (score statistic " << statistic[right] / common << " for "
-          << dof[right] << " dof): its sigma widened to cover a shift of "
-          << rotation.transpose() * (180.0 / M_PI) << " deg; points kept";
-  report->message = message.str();
+void CalibrationFilter::widenRotationVariance(JumpBlock block, const Eigen::Vector3d& added) {
+  if (block == JumpBlock::kNone) return;
+  const int first = block == JumpBlock::kVehicleToLeft ? layout::kCaml : layout::kCamr;
+  covariance_.diagonal().segment<3>(first + layout::kRotation) += added;
 }
 
 bool CalibrationFilter::canReopen(JumpBlock block) const {

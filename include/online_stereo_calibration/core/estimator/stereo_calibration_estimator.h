@@ -16,6 +16,8 @@
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/baseline_from_motion.h"
 #include "online_stereo_calibration/core/estimator/mounting_from_motion.h"
+#include "online_stereo_calibration/core/estimator/restart_from_estimate.h"
+#include "online_stereo_calibration/core/estimator/right_camera_score_test.h"
 #include "online_stereo_calibration/core/estimator/types.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
 #include "online_stereo_calibration/core/geometry/camera_model.h"
@@ -57,6 +59,10 @@ struct CalibrationEstimate {
 struct FrameReport {
   bool motion_rejected = false;  ///< the motion was unusable: points dropped, calibration kept
   StepReport step;               ///< the filter step (empty for the first pair)
+  /// x_camr's rotation was contradicted by the updates beyond its covariance and its variance
+  /// widened to cover the indicated shift, points kept (right_camera_score_test.h; the
+  /// warning says by how much).
+  bool right_rotation_widened = false;
   int new_points = 0;            ///< points initialised from this pair
   int rejected_new_points = 0;   ///< candidate points that did not triangulate in range
   int invalid_observations = 0;  ///< non-finite pixels or sigmas
@@ -129,7 +135,7 @@ class StereoCalibrationEstimator {
   /// x_caml, which keeps its estimate and covariance. At a start the guess takes the same
   /// x_camr (a later hand-eye restart keeps it); after a re-opening it does not. Every point is
   /// forgotten and the odometry states (the time offset) start from their priors. Re-linearised
-  /// (relinearizeIfMoved) as after a start if @p start, else as after a re-opening of x_camr.
+  /// (restart_from_estimate.h) as after a start if @p start, else as after a re-opening of x_camr.
   /// Returns the forgotten points.
   std::vector<PointId> reseedRightCamera(const Eigen::Isometry3d& T_caml_camr,
                                          const Matrix6d& covariance, bool start);
@@ -180,48 +186,14 @@ class StereoCalibrationEstimator {
   const MountingFromMotion& mountingFromMotion() const { return mounting_; }
 
  private:
-  /// Where the filter was last started or a block re-opened (its linearisation point) and
-  /// with which covariance: what relinearizeIfMoved() compares with and restarts with.
-  struct LinearizationAnchor {
-    StereoExtrinsics extrinsics;
-    Matrix12d covariance = Matrix12d::Identity();
-    /// Blocks checked and restarted: both after a start, one after a re-opening.
-    std::array<bool, 2> blocks{{true, true}};
-    /// The re-opened block's sigmas [dt (3), dtheta (3)] (m, rad), to widen it again on a
-    /// restart; 0: that component was not re-opened (and is not checked).
-    Vector6d reopened_sigma = Vector6d::Zero();
-    int frames = 0;    ///< accepted steps since the anchor or the last check
-    int steps = 0;     ///< accepted steps since the start or re-opening (over restarts)
-    int restarts = 0;  ///< restarts since the start or re-opening
-    /// Sum of NIS and number of measurements used since the last check.
-    double nis_sum = 0.0;
-    int nis_count = 0;
-  };
-
   bool toMeasurement(const StereoObservation& observation, PointMeasurement* measurement) const;
   /// What the odometry's scale uncertainty adds to the covariance of the translations at
   /// @p extrinsics (FilterConfig::odometry_scale_sigma; zero when 0).
   Matrix12d odometryScaleCovariance(const StereoExtrinsics& extrinsics) const;
-  /// Anchors at the filter's state now (after a start, or a re-opening of @p block to
-  /// @p reopened_sigma, LinearizationAnchor::reopened_sigma).
-  void anchorHere(JumpBlock block, const Vector6d& reopened_sigma);
-  /// anchorHere after a re-opening of @p block, unless a start's anchor is still live: a
-  /// re-opening while a start is still being re-linearised is part of that start (a guess far
-  /// off gates many points out, or moves the pairs off x_camr's epipolar band), and the
-  /// start's anchor covers both blocks.
-  void anchorReopening(JumpBlock block, const Vector6d& reopened_sigma);
-  /// Largest move since the anchor of a tangent component of @p block (0 x_caml, 1 x_camr)
-  /// that the anchor checks (all after a start, the re-opened ones after a re-opening), in
-  /// the anchor's 1 sigmas; 0 for a block the anchor does not check.
-  double movedSinceAnchor(int block) const;
-  /// The anchor is still checked: fewer than max_relinearizations restarts and
-  /// (max_relinearizations + 1) * relinearization_frames steps since the start or re-opening.
-  bool anchorIsLive() const;
-  /// Every relinearization_frames accepted steps, if the innovations over them were larger
-  /// than relinearization_nis times their expected size: each anchored block that moved more
-  /// than relinearization_threshold is restarted from the current estimate with the anchor's
-  /// uncertainty; every point is dropped into report->dropped. True if it did.
-  bool relinearizeIfMoved(FrameReport* report);
+  /// The linearisation guard's restart (restart_from_estimate.h) after an accepted step:
+  /// every point dropped into report->dropped, FrameReport::relinearized and its warning.
+  /// True if it restarted.
+  bool restartIfLinearizedFarOff(FrameReport* report);
   /// Counts the time without a point measured (FilterConfig::unobserved_gap_s): a rejected
   /// motion or a step that used no measurement adds its dt, a step that used some ends it.
   void countUnobservedTime(const MotionIncrement& motion, const StepReport& step);
@@ -274,7 +246,10 @@ class StereoCalibrationEstimator {
   double unobserved_time_ = 0.0;
   /// s of updates left in which x_caml is tested after an unobserved stretch.
   double gap_check_left_ = 0.0;
-  LinearizationAnchor anchor_;
+  /// Linearisation guard: the restart from the estimate after a start or re-opening far off.
+  RestartFromEstimate restart_;
+  /// Change detection, x_camr: its rotation widened on the evidence of the updates' score.
+  RightCameraScoreTest score_test_;
   /// The last start's guess and its tangent covariance (restartFromMotion starts from them).
   StereoExtrinsics guess_;
   Eigen::MatrixXd guess_covariance_;

@@ -82,10 +82,6 @@ struct StepReport {
   /// After a jump: the sigmas the block's [dt (3), dtheta (3)] were re-opened to (each
   /// component keeps its earlier sigma where that was larger).
   Vector6d jump_sigma = Vector6d::Zero();
-  /// x_camr's rotation was contradicted by the updates beyond its covariance and its variance
-  /// widened to cover the indicated shift, points kept (FilterConfig::jump_score_*; the
-  /// message says by how much).
-  bool right_rotation_widened = false;
   bool covariance_repaired = false;  ///< the calibration covariance had to be made PD
   double mean_nis = 0.0;             ///< mean normalised innovation squared of used points (4 dof)
   /// >= 1: the factor the update's measurement covariances were multiplied by so that no
@@ -139,6 +135,20 @@ class CalibrationFilter {
   /// tangent error (uniformBlockSigmas). Returns the removed points' ids.
   std::vector<PointId> reopen(JumpBlock block, const Vector6d& sigma);
   size_t pointCount() const { return points_.size(); }
+  /// A block may be re-opened: its rotation sigmas are below jump_rotation_sigma and its
+  /// translation sigmas below jump_translation_sigma or it has had jump_settle_time_s since it
+  /// was started or widened (while as uncertain as a re-opened block, many gated-out points are
+  /// the start-up transient, not a change).
+  bool canReopen(JumpBlock block) const;
+  /// Adds @p added (rad^2, per axis) to the variances of @p block's rotation; mean, points and
+  /// correlations kept (a widening on evidence, not a re-opening).
+  void widenRotationVariance(JumpBlock block, const Eigen::Vector3d& added);
+  /// The last step's update scores (consistency_monitor.h), nullptr when its final pass made no
+  /// monitored update (no measurement, a tempered update, the monitor off).
+  const UpdateScores* lastUpdateScores() const { return has_scores_ ? &scores_ : nullptr; }
+  /// How many times the filter was started (reset, restartCalibration): a component that
+  /// counts steps since a start compares it.
+  int starts() const { return starts_; }
   /// How much of the recent vehicle rotation is excitation, per axis (MotionExcitation).
   Eigen::Vector3d excitationGains() const { return excitation_.gains(); }
 
@@ -239,11 +249,6 @@ class CalibrationFilter {
   void predictPoints(const MotionIncrement& motion, const Eigen::MatrixXd& P_global,
                      std::vector<bool>* failed);
   void marginalizeMotionError(const Eigen::MatrixXd& P_global);
-  bool canReopen(JumpBlock block) const;
-  /// After an update: x_camr's score statistic beyond its bound jump_score_updates times in a
-  /// row widens x_camr's rotation variance to cover the indicated shift (FilterConfig::
-  /// jump_score_*). Sets report->right_rotation_widened and its message.
-  void widenRightRotationOnEvidence(StepReport* report);
   /// widenBlock with the config's jump sigmas (the points are the caller's); sets
   /// report->jump_sigma.
   void reopenBlock(JumpBlock block, StepReport* report);
@@ -284,8 +289,8 @@ class CalibrationFilter {
   std::array<double, 2> time_since_opened_ = {0.0, 0.0};
   /// Frames in a row with at least jump_sustained_rejected_fraction of the points gated out.
   int rejection_streak_ = 0;
-  /// Updates in a row whose x_camr score statistic was beyond its bound.
-  int score_streak_ = 0;
+  /// Starts so far (startCalibration).
+  int starts_ = 0;
   PointCoordinates coordinates_;  ///< how TrackedPoint::mean stores a point
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;
