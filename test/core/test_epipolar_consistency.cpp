@@ -137,5 +137,60 @@ TEST(EpipolarLines, MismatchesAloneDoNotContradict) {
   EXPECT_EQ(contradicting, 0);
 }
 
+/// A filter at rig() with x_camr converged (0.003 deg, 0.01 mm) and x_caml at the default
+/// start sigmas.
+CalibrationFilter convergedFilter() {
+  StereoIntrinsics k;
+  k.K_left = k.K_right = intrinsics();
+  CalibrationFilter filter(FilterConfig(), k);
+  Matrix12d covariance = Matrix12d::Identity() * 0.01;
+  covariance.bottomRightCorner<6, 6>() = kConverged;
+  filter.reset(rig(), covariance);
+  return filter;
+}
+
+// The component the estimator calls with every image pair: a knock found in the pair that
+// shows it (epipolar_knock_pairs 1), x_camr's rotation to be re-opened to 3 times the angle
+// the pairs indicate; with 2, at the second pair in a row; never when off or when x_camr holds.
+TEST(EpipolarKnockTest, AKnockIsReportedAfterTheConfiguredPairsInARow) {
+  std::mt19937 rng(23);
+  const CalibrationFilter filter = convergedFilter();
+  const StereoExtrinsics knocked = rig(0.2 * kDeg, 0.0, 0.0);
+  FilterConfig config;
+  EpipolarKnockTest first(EpipolarKnockOptions::from(config));
+  const EpipolarKnock knock =
+      first.test(pairs(knocked, 60, 0.5, &rng), intrinsics(), intrinsics(), filter);
+  ASSERT_TRUE(knock.knocked);
+  EXPECT_NEAR(knock.rotation_sigma, 3.0 * 0.2 * kDeg, 0.3 * kDeg);
+  EXPECT_NE(knock.warning.find("left x_camr's epipolar lines in this image pair"),
+            std::string::npos)
+      << knock.warning;
+
+  config.epipolar_knock_pairs = 2;
+  EpipolarKnockTest second(EpipolarKnockOptions::from(config));
+  EXPECT_FALSE(
+      second.test(pairs(knocked, 60, 0.5, &rng), intrinsics(), intrinsics(), filter).knocked);
+  const EpipolarKnock later =
+      second.test(pairs(knocked, 60, 0.5, &rng), intrinsics(), intrinsics(), filter);
+  EXPECT_TRUE(later.knocked);
+  EXPECT_NE(later.warning.find("in 2 image pairs in a row"), std::string::npos) << later.warning;
+  // A pair that agrees in between starts the streak afresh.
+  EXPECT_FALSE(
+      second.test(pairs(knocked, 60, 0.5, &rng), intrinsics(), intrinsics(), filter).knocked);
+  EXPECT_FALSE(
+      second.test(pairs(rig(), 60, 0.5, &rng), intrinsics(), intrinsics(), filter).knocked);
+  EXPECT_FALSE(
+      second.test(pairs(knocked, 60, 0.5, &rng), intrinsics(), intrinsics(), filter).knocked);
+
+  config.epipolar_knock_false_alarm = 0.0;
+  EpipolarKnockTest off(EpipolarKnockOptions::from(config));
+  EXPECT_FALSE(off.test(pairs(knocked, 60, 0.5, &rng), intrinsics(), intrinsics(), filter).knocked);
+  EpipolarKnockTest holds(EpipolarKnockOptions::from(FilterConfig()));
+  for (int trial = 0; trial < 20; ++trial) {
+    EXPECT_FALSE(
+        holds.test(pairs(rig(), 60, 0.5, &rng), intrinsics(), intrinsics(), filter).knocked);
+  }
+}
+
 }  // namespace
 }  // namespace osc

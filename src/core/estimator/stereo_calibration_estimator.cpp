@@ -62,6 +62,8 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
       filter_(config, stereoIntrinsics(left_, right_)),
       restart_(RestartFromEstimateOptions::from(config)),
       score_test_(RightCameraScoreOptions::from(config)),
+      gap_check_(LeftCameraGapCheckOptions::from(config)),
+      knock_test_(EpipolarKnockOptions::from(config)),
       guess_(initial_guess),
       mounting_(left_, handEyeConfig(config)),
       baseline_from_motion_(baselineConfig(config, left_)) {
@@ -211,15 +213,9 @@ FrameReport StereoCalibrationEstimator::processFrame(
       tracked.clear();
     }
     held_for_few_points_ = report.too_few_points;
-    const bool resumes_after_gap = config_.unobserved_gap > 0.0 &&
-                                   unobserved_time_ >= config_.unobserved_gap && !tracked.empty();
-    if (resumes_after_gap) {
-      // What the monitor saw before the stretch says nothing of what follows it.
-      filter_.forgetConsistencyEvidence();
-      gap_check_left_ = config_.consistency_window;
-    }
+    gap_check_.beforeStep(&filter_, !tracked.empty());
     report.step = filter_.step(motion, tracked);
-    countUnobservedTime(motion, report.step);
+    gap_check_.countAfterStep(motion, report.step);
     if (!report.step.accepted) {
       // Without a usable motion the points cannot be predicted: start tracking afresh.
       report.motion_rejected = true;
@@ -244,7 +240,7 @@ FrameReport StereoCalibrationEstimator::processFrame(
         // x_caml was re-opened on its own evidence: the check after a stretch without points
         // has its answer (left armed, it could re-open the axes a fitted turn kept to
         // jump_rotation_sigma_deg on the next frames' transient).
-        if (report.step.jump == JumpBlock::kVehicleToLeft) gap_check_left_ = 0.0;
+        if (report.step.jump == JumpBlock::kVehicleToLeft) gap_check_.disarm();
       } else if (reopenLeftCameraAfterGap(motion, &report)) {
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());
       } else if (restartIfLinearizedFarOff(&report)) {
@@ -310,32 +306,16 @@ FrameReport StereoCalibrationEstimator::processFrame(
 bool StereoCalibrationEstimator::reopenIfOffEpipolarLines(std::vector<PointMeasurement>* tracked,
                                                           std::vector<PointMeasurement>* candidates,
                                                           FrameReport* report) {
-  if (!(config_.epipolar_knock_false_alarm > 0.0)) return false;
   std::vector<PointMeasurement> pairs = *tracked;
   pairs.insert(pairs.end(), candidates->begin(), candidates->end());
-  using namespace layout;
-  const Matrix6d camr_covariance = filter_.covariance().block<6, 6>(kCamr, kCamr);
-  const EpipolarEvidence evidence =
-      testEpipolarLines(pairs, left_.K(), right_.K(), filter_.extrinsics(), camr_covariance,
-                        config_.epipolar_knock_false_alarm, config_.jump_min_points);
-  pairs_off_epipolar_lines_ = evidence.contradicts ? pairs_off_epipolar_lines_ + 1 : 0;
-  if (pairs_off_epipolar_lines_ < config_.epipolar_knock_pairs) return false;
-  pairs_off_epipolar_lines_ = 0;
-  // The rotation is re-opened to 3 times what the matches indicate. (The lines' tilt may be
-  // the baseline direction's too, which the test cannot tell apart; re-opening it as well
-  // measured mixed: docs/experiments.md, epipolar_knock_baseline_direction.)
-  const std::vector<PointId> forgotten = reopenRightCameraRotation(3.0 * evidence.angle);
+  const EpipolarKnock knock = knock_test_.test(pairs, left_.K(), right_.K(), filter_);
+  if (!knock.knocked) return false;
+  const std::vector<PointId> forgotten = reopenRightCameraRotation(knock.rotation_sigma);
   report->dropped.insert(report->dropped.end(), forgotten.begin(), forgotten.end());
   candidates->insert(candidates->end(), tracked->begin(), tracked->end());
   tracked->clear();
   report->right_camera_off_epipolar_lines = true;
-  const std::string where =
-      config_.epipolar_knock_pairs == 1
-          ? std::string("this image pair")
-          : std::to_string(config_.epipolar_knock_pairs) + " image pairs in a row";
-  report->warnings.push_back(
-      "the stereo pairs left x_camr's epipolar lines in " + where + " (" + evidence.summary() +
-      "): x_camr's rotation re-opened (a knocked right camera?), points re-initialised");
+  report->warnings.push_back(knock.warning);
   return true;
 }
 
@@ -449,37 +429,14 @@ Eigen::Isometry3d StereoCalibrationEstimator::rightCameraTurnedByDisparityOffset
   return T_caml_camr;
 }
 
-void StereoCalibrationEstimator::countUnobservedTime(const MotionIncrement& motion,
-                                                     const StepReport& step) {
-  if (step.accepted && step.measurements_used > 0) {
-    unobserved_time_ = 0.0;
-  } else if (std::isfinite(motion.dt) && motion.dt > 0.0) {
-    unobserved_time_ += motion.dt;
-  }
-}
-
 bool StereoCalibrationEstimator::reopenLeftCameraAfterGap(const MotionIncrement& motion,
                                                           FrameReport* report) {
-  if (!(gap_check_left_ > 0.0) || report->step.measurements_used == 0) return false;
-  gap_check_left_ -= motion.dt;
-  // A few updates at least: one update's score is dominated by its own noise.
-  constexpr int kLeastUpdates = 3;
-  const ConsistencyStatus& consistency = report->step.consistency;
-  const int caml = static_cast<int>(ConsistencyBlock::kVehicleToLeft);
-  if (!consistency.exceeded[caml] || consistency.window_updates < kLeastUpdates) return false;
-  gap_check_left_ = 0.0;
-  const Vector6d sigma =
-      uniformBlockSigmas(config_.jump_translation_sigma, config_.jump_rotation_sigma);
-  const std::vector<PointId> dropped = filter_.reopen(JumpBlock::kVehicleToLeft, sigma);
-  report->dropped.insert(report->dropped.end(), dropped.begin(), dropped.end());
-  restart_.anchorReopening(filter_, JumpBlock::kVehicleToLeft, sigma);
+  const GapDecision decision = gap_check_.checkAfterStep(&filter_, motion, report->step);
+  if (!decision.reopened) return false;
+  report->dropped.insert(report->dropped.end(), decision.dropped.begin(), decision.dropped.end());
+  restart_.anchorReopening(filter_, JumpBlock::kVehicleToLeft, decision.sigma);
   report->left_camera_reopened_after_gap = true;
-  std::ostringstream message;
-  message << "x_caml re-opened: the updates after a stretch without points disagree with it "
-          << "(consistency statistic " << consistency.statistic[caml] << " > "
-          << consistency.bound[caml] << " over " << consistency.window_updates
-          << " updates; the mounting changed while nothing was seen?); points re-initialised";
-  report->warnings.push_back(message.str());
+  report->warnings.push_back(decision.warning);
   return true;
 }
 
@@ -573,10 +530,9 @@ void StereoCalibrationEstimator::forgetDriveEvidence() {
   forgetBaselineEvidence();
   held_for_few_points_ = false;
   unmeasurable_pairs_ = 0;
-  pairs_off_epipolar_lines_ = 0;
+  knock_test_.reset();
   mounting_.clear();
-  unobserved_time_ = 0.0;
-  gap_check_left_ = 0.0;
+  gap_check_.reset();
 }
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {

@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 
+#include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 
@@ -53,5 +54,40 @@ EpipolarEvidence testEpipolarLines(const std::vector<PointMeasurement>& pairs,
                                    const StereoExtrinsics& extrinsics,
                                    const Matrix6d& camr_covariance, double false_alarm,
                                    int min_pairs);
+
+/// The knock test's options (FilterConfig keys).
+struct EpipolarKnockOptions {
+  double false_alarm = 1e-6;  ///< epipolar_knock_false_alarm per image pair; 0 = off
+  int pairs = 1;              ///< epipolar_knock_pairs: contradicting image pairs in a row
+  int min_pairs = 8;          ///< jump_min_points: fewest stereo pairs that can contradict
+
+  static EpipolarKnockOptions from(const FilterConfig& config);
+};
+
+/// What one image pair's test found.
+struct EpipolarKnock {
+  bool knocked = false;         ///< `pairs` image pairs in a row contradicted x_camr
+  double rotation_sigma = 0.0;  ///< x_camr's rotation re-opening: 3 x the indicated angle (rad)
+  std::string warning;          ///< the event's line (empty when nothing was found)
+};
+
+/// Change detection, x_camr: the streak of image pairs whose stereo pairs contradict x_camr's
+/// epipolar lines (docs/design.md). The caller re-opens x_camr's rotation on a knock, before
+/// the update: after a knock the tracked points would pull x_camr with its old sigma, or gate
+/// out and be blamed on x_caml.
+class EpipolarKnockTest {
+ public:
+  explicit EpipolarKnockTest(const EpipolarKnockOptions& options) : options_(options) {}
+  /// Tests one image pair's stereo pairs (tracked and new; undistorted pixels) against
+  /// @p filter's x_camr and its covariance.
+  EpipolarKnock test(const std::vector<PointMeasurement>& pairs, const Eigen::Matrix3d& K_left,
+                     const Eigen::Matrix3d& K_right, const CalibrationFilter& filter);
+  /// Forgets the streak (a reset).
+  void reset() { streak_ = 0; }
+
+ private:
+  EpipolarKnockOptions options_;
+  int streak_ = 0;  ///< image pairs in a row that contradicted x_camr's epipolar lines
+};
 
 }  // namespace osc

@@ -15,6 +15,8 @@
 
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/baseline_from_motion.h"
+#include "online_stereo_calibration/core/estimator/epipolar_consistency.h"
+#include "online_stereo_calibration/core/estimator/left_camera_gap_check.h"
 #include "online_stereo_calibration/core/estimator/mounting_from_motion.h"
 #include "online_stereo_calibration/core/estimator/restart_from_estimate.h"
 #include "online_stereo_calibration/core/estimator/right_camera_score_test.h"
@@ -194,13 +196,9 @@ class StereoCalibrationEstimator {
   /// every point dropped into report->dropped, FrameReport::relinearized and its warning.
   /// True if it restarted.
   bool restartIfLinearizedFarOff(FrameReport* report);
-  /// Counts the time without a point measured (FilterConfig::unobserved_gap_s): a rejected
-  /// motion or a step that used no measurement adds its dt, a step that used some ends it.
-  void countUnobservedTime(const MotionIncrement& motion, const StepReport& step);
-  /// Within consistency_window_s of updates after an unobserved stretch: if the consistency
-  /// monitor's x_caml statistic exceeds its bound, re-opens x_caml (jump sigmas; every point
-  /// dropped into report->dropped, FrameReport::left_camera_reopened_after_gap). True if it
-  /// did.
+  /// The gap check (left_camera_gap_check.h) after an accepted step without a jump: x_caml
+  /// re-opened (every point dropped into report->dropped,
+  /// FrameReport::left_camera_reopened_after_gap, its warning) and anchored. True if it did.
   bool reopenLeftCameraAfterGap(const MotionIncrement& motion, FrameReport* report);
   /// Counts the pairs whose @p tracked points were all measured and none predictable, and
   /// warns (FrameReport::no_point_measurable) at the kUnmeasurablePairsToWarn-th in a row.
@@ -240,16 +238,14 @@ class StereoCalibrationEstimator {
   /// Pairs in a row whose tracked points were all measured and none predictable
   /// (FrameReport::no_point_measurable).
   int unmeasurable_pairs_ = 0;
-  /// Pairs in a row whose stereo pairs contradicted x_camr's epipolar lines.
-  int pairs_off_epipolar_lines_ = 0;
-  /// s without a point measured so far (countUnobservedTime).
-  double unobserved_time_ = 0.0;
-  /// s of updates left in which x_caml is tested after an unobserved stretch.
-  double gap_check_left_ = 0.0;
   /// Linearisation guard: the restart from the estimate after a start or re-opening far off.
   RestartFromEstimate restart_;
   /// Change detection, x_camr: its rotation widened on the evidence of the updates' score.
   RightCameraScoreTest score_test_;
+  /// Change detection, x_caml: tested when points come back after a stretch without any.
+  LeftCameraGapCheck gap_check_;
+  /// Change detection, x_camr: its epipolar lines tested with every image pair.
+  EpipolarKnockTest knock_test_;
   /// The last start's guess and its tangent covariance (restartFromMotion starts from them).
   StereoExtrinsics guess_;
   Eigen::MatrixXd guess_covariance_;
