@@ -551,10 +551,15 @@ TEST(PerfectFilter, IsHonestInTheRunsItsStatisticsPredict) {
   EXPECT_LT(long_runs.honest_high, 0.90);
   EXPECT_LT(long_runs.beyond_5sigma, 0.01);
   EXPECT_NEAR(long_runs.mean_share, 0.968, 0.004);
-  // The same seed, the same figures.
+  // The same seed, the same figures (drawn once per process); another seed, figures within
+  // the draw's own spread.
   const PerfectFilterScore again = perfectFilterScore(600, 1000);
   EXPECT_EQ(again.honest_low, long_runs.honest_low);
   EXPECT_EQ(again.honest_high, long_runs.honest_high);
+  const PerfectFilterScore other = perfectFilterScore(600, 1000, 2);
+  EXPECT_NE(other.mean_share, long_runs.mean_share);  // drawn anew, not the cached figures
+  EXPECT_NEAR(other.honest_low, long_runs.honest_low, 0.06);
+  EXPECT_NEAR(other.honest_high, long_runs.honest_high, 0.06);
   EXPECT_THROW(perfectFilterScore(30), std::invalid_argument);
   // The summary puts it beside the campaign.
   std::vector<CampaignRow> rows(2);

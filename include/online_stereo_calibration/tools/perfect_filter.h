@@ -26,7 +26,8 @@ struct PerfectFilterScore {
 };
 
 /// Draws @p runs_per_model runs of @p frames frames (> 30) of each model from @p seed (the
-/// same figures on every machine). About 0.1 s for 1000 runs of 600 frames.
+/// same figures on every machine); drawn once per process for the same arguments. About
+/// 0.8 s for 1000 runs of 600 frames.
 /// @throws std::invalid_argument if frames <= 30 or runs_per_model < 1.
 PerfectFilterScore perfectFilterScore(int frames, int runs_per_model = 1000,
                                       std::uint64_t seed = 1);

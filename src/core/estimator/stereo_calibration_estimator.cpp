@@ -226,13 +226,6 @@ FrameReport StereoCalibrationEstimator::processFrame(
       report.dropped = report.step.lost;
       report.dropped.insert(report.dropped.end(), report.step.outliers.begin(),
                             report.step.outliers.end());
-      // Not a re-opening: the points stay, and the re-linearisation check below counts the
-      // frame as any other.
-      if (report.step.jump == JumpBlock::kNone) {
-        const ScoreWidening widening = score_test_.afterStep(&filter_);
-        report.right_rotation_widened = widening.widened;
-        if (widening.widened) report.warnings.push_back(widening.warning);
-      }
       if (report.step.jump != JumpBlock::kNone) {
         report.warnings.push_back(report.step.message);
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());
@@ -241,12 +234,19 @@ FrameReport StereoCalibrationEstimator::processFrame(
         // has its answer (left armed, it could re-open the axes a fitted turn kept to
         // jump_rotation_sigma_deg on the next frames' transient).
         if (report.step.jump == JumpBlock::kVehicleToLeft) gap_check_.disarm();
-      } else if (reopenLeftCameraAfterGap(motion, &report)) {
-        candidates.insert(candidates.end(), tracked.begin(), tracked.end());
-      } else if (restartIfLinearizedFarOff(&report)) {
-        // Tracking starts afresh with the next pair, as after a start.
-        candidates.clear();
-        has_previous_frame_ = false;
+      } else {
+        // A widening is not a re-opening: the points stay, and the checks below count the
+        // frame as any other.
+        const ScoreWidening widening = score_test_.afterStep(&filter_);
+        report.right_rotation_widened = widening.widened;
+        if (widening.widened) report.warnings.push_back(widening.warning);
+        if (reopenLeftCameraAfterGap(motion, &report)) {
+          candidates.insert(candidates.end(), tracked.begin(), tracked.end());
+        } else if (restartIfLinearizedFarOff(&report)) {
+          // Tracking starts afresh with the next pair, as after a start.
+          candidates.clear();
+          has_previous_frame_ = false;
+        }
       }
       if (report.step.covariance_repaired) {
         report.warnings.push_back(

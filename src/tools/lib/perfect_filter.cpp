@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include "online_stereo_calibration/tools/campaign_csv.h"
 #include "online_stereo_calibration/tools/campaign_score.h"
@@ -60,6 +63,14 @@ PerfectFilterScore perfectFilterScore(int frames, int runs_per_model, std::uint6
                                 std::to_string(kCampaignFirstScoredFrame) +
                                 " and runs_per_model at least 1");
   }
+  // The same arguments give the same figures: drawn once per process (the campaign's summary
+  // and its last line both ask for them; ~0.8 s for 1000 runs of 600 frames).
+  static std::mutex mutex;
+  static std::map<std::tuple<int, int, std::uint64_t>, PerfectFilterScore> drawn;
+  const std::lock_guard<std::mutex> lock(mutex);
+  const auto key = std::make_tuple(frames, runs_per_model, seed);
+  const auto found = drawn.find(key);
+  if (found != drawn.end()) return found->second;
   PerfectFilterScore score;
   score.frames = frames;
   score.runs_per_model = runs_per_model;
@@ -82,6 +93,7 @@ PerfectFilterScore perfectFilterScore(int frames, int runs_per_model, std::uint6
         std::max(score.beyond_5sigma, static_cast<double>(beyond) / runs_per_model);
     score.mean_share += shares / runs_per_model / static_cast<double>(taus.size());
   }
+  drawn[key] = score;
   return score;
 }
 

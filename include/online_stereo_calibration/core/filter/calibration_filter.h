@@ -195,8 +195,8 @@ class CalibrationFilter {
     Eigen::Matrix3d D = Eigen::Matrix3d::Zero();
     bool updated = false;  ///< has had a Kalman update
   };
-  struct PointInnovation;  // defined in the .cpp
-  struct Prediction;       // defined in the .cpp
+  struct PointInnovation;  // defined in src/core/filter/calibration_filter_internal.h
+  struct Prediction;       // defined in src/core/filter/calibration_filter_internal.h
 
   std::string checkMotion(const MotionIncrement& motion) const;
   /// The inverse depth (1/m) below which a point is placed, where a position is needed (its
