@@ -437,59 +437,19 @@ void CalibrationNodelet::processPair(const StereoPair& pair) {
   }
   last_stamp_ = stamp;
   diagnostics_->tickProcessed();
-  if (result.estimator.motion_rejected) {
-    diagnostics_->recordProblem("motion rejected", result.status);
-  }
-  // The estimator's own reports (issue 14): what it did at a start far off, and why it
-  // cannot start at all.
-  for (const std::string& warning : result.estimator.warnings) {
-    if (result.estimator.relinearized && warning.rfind("restarted", 0) == 0) {
-      diagnostics_->recordProblem("start re-linearised", warning);
-    }
-    if (result.estimator.no_point_initialised &&
-        warning.rfind("no point could be initialised", 0) == 0) {
-      diagnostics_->recordProblem("no point initialised", warning);
-    }
-    if (result.estimator.mounting_rotation_from_motion &&
-        warning.rfind("mounting rotation from motion", 0) == 0) {
-      diagnostics_->recordProblem("mounting rotation from motion", warning);
-    }
-    if (result.estimator.right_rotation_widened && warning.rfind("x_camr's rotation", 0) == 0) {
-      diagnostics_->recordProblem("right camera rotation contradicted", warning);
-    }
-    if (result.estimator.right_camera_off_epipolar_lines &&
-        warning.rfind("the stereo pairs left x_camr's epipolar lines", 0) == 0) {
-      diagnostics_->recordProblem("right camera off its epipolar lines", warning);
-    }
-    if (result.estimator.left_camera_reopened_after_gap &&
-        warning.rfind("x_caml re-opened", 0) == 0) {
-      diagnostics_->recordProblem("left camera re-opened after a stretch without points", warning);
-    }
-    if (result.estimator.too_few_points && warning.rfind("too few points", 0) == 0) {
-      diagnostics_->recordProblem("too few points to update", warning);
-    }
-    if (result.estimator.no_point_measurable &&
-        warning.rfind("no tracked point could be predicted", 0) == 0) {
-      diagnostics_->recordProblem("no point measurable", warning);
-    }
-    if (result.estimator.baseline_from_motion &&
-        warning.rfind("baseline length from motion", 0) == 0) {
-      diagnostics_->recordProblem("baseline length from motion", warning);
-    }
-    if (result.estimator.right_rotation_from_stereo_fit &&
-        warning.rfind("right camera rotation from the stereo fit", 0) == 0) {
-      diagnostics_->recordProblem("right camera rotation from stereo fit", warning);
-    }
-  }
-  for (const std::string& warning : result.estimator.warnings) {
-    NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: %s", warning.c_str());
+  // The estimator's event log (frame_event.h): what each component did, and why the filter
+  // cannot learn (issue 14), one diagnostics entry per kind.
+  for (const osc::FrameEventLine& event : result.estimator.events) {
+    diagnostics_->recordProblem(osc::frameEventName(event.kind), event.text);
+    NODELET_WARN_THROTTLE(5.0, "online_stereo_calibration: %s", event.text.c_str());
   }
   if (result.right_camera_reopened) {
     NODELET_WARN("online_stereo_calibration: %s", result.status.c_str());
   }
   // A change found by the filter's jump test, or by the pipeline (a knocked right camera).
   const bool jump = result.estimator.step.jump != osc::JumpBlock::kNone ||
-                    result.estimator.right_rotation_widened || result.right_camera_reopened;
+                    result.estimator.has(osc::FrameEvent::kRightRotationWidened) ||
+                    result.right_camera_reopened;
   const uint8_t state = calibrationState(result.estimate, jump, config_.ros.min_tracked_points,
                                          config_.ros.converged);
   StereoCalibration message =

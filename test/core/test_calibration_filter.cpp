@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Cholesky>
 
+#include "online_stereo_calibration/core/estimator/jump_test.h"
 #include "online_stereo_calibration/core/estimator/right_camera_score_test.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
 #include "online_stereo_calibration/core/filter/dense_calibration_ukf.h"
@@ -483,7 +484,7 @@ TEST(CalibrationFilter, NewFarInverseDepthPointUnderAWideRightCameraPriorMatches
 /// A filter converged at the truth whose left camera then turns 5 deg about the vehicle's
 /// vertical between frames 3 and 4 (a yaw step of its mounting).
 StepReport stepAcrossALeftCameraYawStep(SmallProblem* problem, CalibrationFilter* filter,
-                                        double* error_before = nullptr) {
+                                        double* error_before = nullptr, bool detect = true) {
   Vector12d sigma;
   sigma << 0.01, 0.01, 0.01, 0.1 * kDeg, 0.1 * kDeg, 0.1 * kDeg, 0.005, 0.005, 0.005, 0.05 * kDeg,
       0.05 * kDeg, 0.05 * kDeg;
@@ -497,7 +498,10 @@ StepReport stepAcrossALeftCameraYawStep(SmallProblem* problem, CalibrationFilter
   const Eigen::Matrix3d turned =
       rotationFromRpy(Eigen::Vector3d(0, 0, 5 * kDeg)) * problem->truth.T_veh_caml.linear();
   problem->truth.T_veh_caml.linear() = turned;
-  return filter->step(problem->motion(4), problem->measure(4, 0.3));
+  if (!detect) return filter->step(problem->motion(4), problem->measure(4, 0.3));
+  JumpTest jump_test(JumpTestOptions::from(filter->config()));
+  return filter->step(problem->motion(4), problem->measure(4, 0.3),
+                      [&](const GateOutcome& gate) { return jump_test.decide(gate, *filter); });
 }
 
 TEST(CalibrationFilter, ALeftCameraYawStepIsFittedAndOnlyTheTurnedAxisReopened) {
@@ -529,6 +533,18 @@ TEST(CalibrationFilter, ALeftCameraYawStepIsFittedAndOnlyTheTurnedAxisReopened) 
       << report.message;
 }
 
+// The filter predicts, gates and updates; deciding that a block jumped is a change
+// detector's (JumpTest). Without one the same yaw step only gates the points out.
+TEST(CalibrationFilter, WithoutAChangeDetectorAJumpOnlyGatesPointsOut) {
+  SmallProblem problem(40, 8);
+  CalibrationFilter filter(FilterConfig(), problem.K);
+  const StepReport report = stepAcrossALeftCameraYawStep(&problem, &filter, nullptr, false);
+  EXPECT_TRUE(report.accepted);
+  EXPECT_EQ(report.jump, JumpBlock::kNone);
+  EXPECT_GE(report.outliers.size(), 30u);
+  EXPECT_LT(std::sqrt(filter.covariance()(5, 5)), 1 * kDeg);  // nothing re-opened
+}
+
 /// Steps a filter converged at the truth over frames 1-3, then turns the right camera by
 /// @p pitch_r before frame 4 and steps frames 4-7 with the score test after each step without
 /// a jump; the frame at which the test widened x_camr's rotation (-1: never) and x_camr's
@@ -542,13 +558,17 @@ int scoreTestAfterAKnock(double pitch_r, double* sigma_after, bool* jumped) {
       0.05 * kDeg, 0.05 * kDeg;
   filter.reset(problem.truth, sigma.array().square().matrix().asDiagonal());
   for (const PointMeasurement& m : problem.measure(0, 0.3)) filter.addPoint(m);
+  JumpTest jump_test(JumpTestOptions::from(FilterConfig()));
+  const ChangeDetector detect = [&](const GateOutcome& gate) {
+    return jump_test.decide(gate, filter);
+  };
   *jumped = false;
   for (int k = 1; k < 8; ++k) {
     if (k == 4) {
       problem.truth.T_caml_camr.linear() =
           problem.truth.T_caml_camr.linear() * rotationFromRpy(Eigen::Vector3d(0, pitch_r, 0));
     }
-    const StepReport step = filter.step(problem.motion(k), problem.measure(k, 0.3));
+    const StepReport step = filter.step(problem.motion(k), problem.measure(k, 0.3), detect);
     EXPECT_TRUE(step.accepted);
     if (step.jump != JumpBlock::kNone) {
       *jumped = true;

@@ -245,21 +245,21 @@ Scored score(const MeasurementScenario& s, const FilterConfig& config, int first
   while (simulator.nextFrame(&frame)) {
     const FrameReport report = estimator.processFrame(frame.measured_motion, frame.observations);
     simulator.dropTracks(report.dropped);
-    if (report.mounting_rotation_from_motion) {
+    if (report.has(FrameEvent::kMountingRotationFromMotion)) {
       ++out.restarts;
       out.restart_frame = frame.index;
     }
     const ScenarioFrameResult r = makeFrameResult(frame, estimator.estimate(), report, 0.0);
-    if (report.mounting_rotation_from_motion) {
+    if (report.has(FrameEvent::kMountingRotationFromMotion)) {
       out.rotation_error_at_restart = r.tangent_error.segment<3>(3).norm();
     }
     if (getenv("OSC_HAND_EYE_TRACE") != nullptr) {
       std::cout
           << "frame " << r.frame << " points " << r.tracked_points << " err/sigma "
           << r.tangent_error.cwiseQuotient(r.tangent_sigmas).transpose().format(Eigen::IOFormat(2))
-          << (report.mounting_rotation_from_motion ? " RESTART" : "")
-          << (report.relinearized ? " relin" : "") << "\n";
-      for (const std::string& w : report.warnings) std::cout << "  " << w << "\n";
+          << (report.has(FrameEvent::kMountingRotationFromMotion) ? " RESTART" : "")
+          << (report.has(FrameEvent::kRelinearized) ? " relin" : "") << "\n";
+      for (const FrameEventLine& e : report.events) std::cout << "  " << e.text << "\n";
       if (!estimator.mountingFromMotion().done()) {
         const HandEyeRotationResult h = estimator.mountingFromMotion().solve();
         std::cout << "  hand-eye: " << h.reason << " res " << h.rotation_residual / kDeg << " "
@@ -360,10 +360,13 @@ TEST(HandEyeStart, RestartKeepsTheGuessCovarianceOfTheRightCamera) {
   while (!restarted && simulator.nextFrame(&frame)) {
     const FrameReport report = estimator.processFrame(frame.measured_motion, frame.observations);
     simulator.dropTracks(report.dropped);
-    restarted = report.mounting_rotation_from_motion;
+    restarted = report.has(FrameEvent::kMountingRotationFromMotion);
     if (!restarted) continue;
-    ASSERT_FALSE(report.warnings.empty());
-    EXPECT_NE(report.warnings.back().find("mounting rotation from motion"), std::string::npos);
+    ASSERT_FALSE(report.events.empty());
+    const FrameEventLine& event = *report.events.begin();
+    EXPECT_EQ(event.kind, FrameEvent::kMountingRotationFromMotion);
+    EXPECT_NE(event.text.find("mounting rotation from motion: x_caml restarted"),
+              std::string::npos);
     CalibrationEstimate e = estimator.estimate();
     // The filter's own covariance: without what the odometry's scale adds to the report.
     e.tangent_covariance -= e.odometry_scale_covariance;
@@ -461,7 +464,7 @@ TEST(HandEyeStart, DISABLED_ImageLevelReport) {
             cv::imread(sequence.left_images[static_cast<size_t>(k)], cv::IMREAD_GRAYSCALE),
             cv::imread(sequence.right_images[static_cast<size_t>(k)], cv::IMREAD_GRAYSCALE),
             k > 0 ? sequence.motion(k) : MotionIncrement());
-        if (r.estimator.mounting_rotation_from_motion) restart = k;
+        if (r.estimator.has(FrameEvent::kMountingRotationFromMotion)) restart = k;
       }
       const HandEyeRotationResult h = pipeline.estimator().mountingFromMotion().solve();
       const Eigen::Matrix3d X = StereoExtrinsics::fromParameters(truth).T_veh_caml.linear();

@@ -63,7 +63,7 @@ KittiRun runKitti(const KittiSequence& sequence, const Vector12d& start_error,
     run.errors.push_back(parameterErrors(r.estimate.parameters, truth));
     run.sigmas.push_back(r.estimate.sigmas());
     run.points.push_back(static_cast<int>(r.estimate.tracked_points));
-    run.restarted.push_back(r.estimator.relinearized);
+    run.restarted.push_back(r.estimator.has(FrameEvent::kRelinearized));
     run.time_offsets.push_back(r.estimate.time_offset);
     run.time_offset_sigmas.push_back(r.estimate.time_offset_sigma);
   }

@@ -250,8 +250,9 @@ TEST(Start, NoPointAtAllIsExplainedByTheBaseline) {
     while (simulator.nextFrame(&frame)) {
       const FrameReport report = estimator.processFrame(frame.measured_motion, frame.observations);
       simulator.dropTracks(report.dropped);
-      for (const std::string& w : report.warnings) warnings += w + "\n";
-      EXPECT_EQ(report.no_point_initialised, yr_error > 0.09) << "frame " << frame.index;
+      for (const FrameEventLine& e : report.events) warnings += e.text + "\n";
+      EXPECT_EQ(report.has(FrameEvent::kNoPointInitialised), yr_error > 0.09)
+          << "frame " << frame.index;
     }
     if (yr_error > 0.09) {
       EXPECT_EQ(estimator.estimate().tracked_points, 0u);
@@ -420,7 +421,7 @@ TEST(FewPoints, APairWithFewerStereoPairsThanTheMinimumIsPredictedNotUpdated) {
       EXPECT_GT((updated.estimate().parameters - updated_blind.estimate().parameters).norm(), 1e-6)
           << "without the rule the 3 points update the calibration";
       EXPECT_EQ(a.new_points, 3) << "the 3 points start afresh";
-      for (const std::string& w : a.warnings) warnings += w + "\n";
+      for (const FrameEventLine& e : a.events) warnings += e.text + "\n";
       continue;  // the simulator keeps every track: a texture-poor view is the filter's view
     }
     const FrameReport a = held.processFrame(frame.measured_motion, seen);

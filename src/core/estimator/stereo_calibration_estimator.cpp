@@ -61,6 +61,7 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
       right_(right),
       filter_(config, stereoIntrinsics(left_, right_)),
       restart_(RestartFromEstimateOptions::from(config)),
+      jump_test_(JumpTestOptions::from(config)),
       score_test_(RightCameraScoreOptions::from(config)),
       gap_check_(LeftCameraGapCheckOptions::from(config)),
       knock_test_(EpipolarKnockOptions::from(config)),
@@ -76,8 +77,7 @@ bool StereoCalibrationEstimator::restartIfLinearizedFarOff(FrameReport* report) 
   const RestartDecision decision = restart_.checkAfterStep(&filter_, report->step);
   if (!decision.restarted) return false;
   report->dropped.insert(report->dropped.end(), decision.dropped.begin(), decision.dropped.end());
-  report->relinearized = true;
-  report->warnings.push_back(decision.warning);
+  report->events.add(FrameEvent::kRelinearized, decision.warning);
   return true;
 }
 
@@ -116,7 +116,6 @@ bool StereoCalibrationEstimator::restartFromMotion(
   filter_.reset(start, covariance);
   // A start: both blocks re-linearised as after one.
   restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
-  report->mounting_rotation_from_motion = true;
   const Eigen::Vector3d before = rpyFromRotation(now.T_veh_caml.linear()) * 180.0 / M_PI;
   const Eigen::Vector3d after = rpyFromRotation(restart.R_veh_caml) * 180.0 / M_PI;
   std::ostringstream message;
@@ -127,7 +126,7 @@ bool StereoCalibrationEstimator::restartFromMotion(
           << restart.hand_eye.reason
           << "); everything else from the guess again, translation 1 sigma " << translation_sigma
           << " m; tracks reset";
-  report->warnings.push_back(message.str());
+  report->events.add(FrameEvent::kMountingRotationFromMotion, message.str());
   return true;
 }
 
@@ -182,10 +181,11 @@ FrameReport StereoCalibrationEstimator::processFrame(
     (filter_.hasPoint(o.id) ? tracked : candidates).push_back(m);
   }
   if (report.invalid_observations > 0) {
-    report.warnings.push_back(
+    report.events.add(
+        FrameEvent::kObservationsIgnored,
         std::to_string(report.invalid_observations) +
-        " observation(s) ignored: NaN/Inf pixel or sigma, or a pixel no ray of the lens "
-        "model reaches");
+            " observation(s) ignored: NaN/Inf pixel or sigma, or a pixel no ray of the lens "
+            "model reaches");
   }
 
   // Before the update: after a knock the tracked points would pull x_camr with its old
@@ -204,22 +204,24 @@ FrameReport StereoCalibrationEstimator::processFrame(
     report.too_few_points = !tracked.empty() && seen < needed;
     if (report.too_few_points) {
       if (!held_for_few_points_) {
-        report.warnings.push_back("too few points: " + std::to_string(seen) +
-                                  " stereo pairs, fewer than min_points_to_update " +
-                                  std::to_string(needed) +
-                                  "; the calibration is kept, not updated, until more are seen");
+        report.events.add(FrameEvent::kTooFewPoints,
+                          "too few points: " + std::to_string(seen) +
+                              " stereo pairs, fewer than min_points_to_update " +
+                              std::to_string(needed) +
+                              "; the calibration is kept, not updated, until more are seen");
       }
       candidates.insert(candidates.end(), tracked.begin(), tracked.end());
       tracked.clear();
     }
     held_for_few_points_ = report.too_few_points;
     gap_check_.beforeStep(&filter_, !tracked.empty());
-    report.step = filter_.step(motion, tracked);
+    report.step = filter_.step(motion, tracked, [this](const GateOutcome& gate) {
+      return jump_test_.decide(gate, filter_);
+    });
     gap_check_.countAfterStep(motion, report.step);
     if (!report.step.accepted) {
       // Without a usable motion the points cannot be predicted: start tracking afresh.
-      report.motion_rejected = true;
-      report.warnings.push_back("motion rejected: " + report.step.message);
+      report.events.add(FrameEvent::kMotionRejected, "motion rejected: " + report.step.message);
       report.dropped = resetTracking();
       candidates.insert(candidates.end(), tracked.begin(), tracked.end());
     } else {
@@ -227,7 +229,7 @@ FrameReport StereoCalibrationEstimator::processFrame(
       report.dropped.insert(report.dropped.end(), report.step.outliers.begin(),
                             report.step.outliers.end());
       if (report.step.jump != JumpBlock::kNone) {
-        report.warnings.push_back(report.step.message);
+        report.events.add(FrameEvent::kJump, report.step.message);
         candidates.insert(candidates.end(), tracked.begin(), tracked.end());
         restart_.anchorReopening(filter_, report.step.jump, report.step.jump_sigma);
         // x_caml was re-opened on its own evidence: the check after a stretch without points
@@ -238,8 +240,8 @@ FrameReport StereoCalibrationEstimator::processFrame(
         // A widening is not a re-opening: the points stay, and the checks below count the
         // frame as any other.
         const ScoreWidening widening = score_test_.afterStep(&filter_);
-        report.right_rotation_widened = widening.widened;
-        if (widening.widened) report.warnings.push_back(widening.warning);
+        if (widening.widened)
+          report.events.add(FrameEvent::kRightRotationWidened, widening.warning);
         if (reopenLeftCameraAfterGap(motion, &report)) {
           candidates.insert(candidates.end(), tracked.begin(), tracked.end());
         } else if (restartIfLinearizedFarOff(&report)) {
@@ -249,13 +251,13 @@ FrameReport StereoCalibrationEstimator::processFrame(
         }
       }
       if (report.step.covariance_repaired) {
-        report.warnings.push_back(
-            "calibration covariance was not positive definite and was repaired");
+        report.events.add(FrameEvent::kCovarianceRepaired,
+                          "calibration covariance was not positive definite and was repaired");
       }
     }
     warnIfNoPointMeasurable(tracked, &report);
   }
-  if (!report.relinearized) has_previous_frame_ = true;
+  if (!report.has(FrameEvent::kRelinearized)) has_previous_frame_ = true;
 
   // New points after the correction, so they start from the best calibration (Sec. II-A).
   for (const PointMeasurement& m : candidates) {
@@ -269,10 +271,10 @@ FrameReport StereoCalibrationEstimator::processFrame(
   }
   // Stereo pairs but not one point: the filter cannot learn anything (issue 14: an 11 cm rig
   // guessed at 1 cm stayed at 0 points for 800 frames with no other sign). Say why.
-  report.no_point_initialised = filter_.pointCount() == 0 &&
-                                report.rejected_new_points >= kFewestPairsToExplain &&
-                                report.new_points == 0;
-  if (report.no_point_initialised) {
+  const bool no_point_initialised = filter_.pointCount() == 0 &&
+                                    report.rejected_new_points >= kFewestPairsToExplain &&
+                                    report.new_points == 0;
+  if (no_point_initialised) {
     const CalibrationEstimate e = estimate();
     std::ostringstream message;
     message << "no point could be initialised: none of " << report.rejected_new_points
@@ -286,11 +288,11 @@ FrameReport StereoCalibrationEstimator::processFrame(
               << (length.valid ? "so far " + std::to_string(length.length) + " m" : length.why)
               << ")";
     }
-    report.warnings.push_back(message.str());
+    report.events.add(FrameEvent::kNoPointInitialised, message.str());
   }
-  if (config_.baseline_from_motion != 0 && report.no_point_initialised) {
-    report.baseline_from_motion = learnBaselineLength(
-        motion, follows_previous_pair && !report.motion_rejected, candidates, &report);
+  if (config_.baseline_from_motion != 0 && no_point_initialised) {
+    learnBaselineLength(motion, follows_previous_pair && !report.has(FrameEvent::kMotionRejected),
+                        candidates, &report);
   } else {
     forgetBaselineEvidence();
   }
@@ -314,8 +316,7 @@ bool StereoCalibrationEstimator::reopenIfOffEpipolarLines(std::vector<PointMeasu
   report->dropped.insert(report->dropped.end(), forgotten.begin(), forgotten.end());
   candidates->insert(candidates->end(), tracked->begin(), tracked->end());
   tracked->clear();
-  report->right_camera_off_epipolar_lines = true;
-  report->warnings.push_back(knock.warning);
+  report->events.add(FrameEvent::kRightCameraOffEpipolarLines, knock.warning);
   return true;
 }
 
@@ -415,7 +416,7 @@ bool StereoCalibrationEstimator::learnBaselineLength(
           << (turned ? ": x_camr turned by it about the axis across the baseline and the view"
                      : "");
   message << "; tracks reset";
-  report->warnings.push_back(message.str());
+  report->events.add(FrameEvent::kBaselineFromMotion, message.str());
   return true;
 }
 
@@ -435,8 +436,7 @@ bool StereoCalibrationEstimator::reopenLeftCameraAfterGap(const MotionIncrement&
   if (!decision.reopened) return false;
   report->dropped.insert(report->dropped.end(), decision.dropped.begin(), decision.dropped.end());
   restart_.anchorReopening(filter_, JumpBlock::kVehicleToLeft, decision.sigma);
-  report->left_camera_reopened_after_gap = true;
-  report->warnings.push_back(decision.warning);
+  report->events.add(FrameEvent::kLeftCameraReopenedAfterGap, decision.warning);
   return true;
 }
 
@@ -511,7 +511,6 @@ void StereoCalibrationEstimator::warnIfNoPointMeasurable(
                                report->step.measurements_used == 0 && report->step.outliers.empty();
   unmeasurable_pairs_ = none_measurable ? unmeasurable_pairs_ + 1 : 0;
   if (unmeasurable_pairs_ != kUnmeasurablePairsToWarn) return;
-  report->no_point_measurable = true;
   using namespace layout;
   const double rotation_sigma =
       std::sqrt(filter_.covariance().diagonal().segment<3>(kCamr + kRotation).maxCoeff());
@@ -523,7 +522,7 @@ void StereoCalibrationEstimator::warnIfNoPointMeasurable(
           << rotation_sigma * 180.0 / M_PI
           << " deg); the calibration is predicted, not updated, until points can be "
              "predicted again";
-  report->warnings.push_back(message.str());
+  report->events.add(FrameEvent::kNoPointMeasurable, message.str());
 }
 
 void StereoCalibrationEstimator::forgetDriveEvidence() {

@@ -15,7 +15,6 @@
 #include "online_stereo_calibration/core/filter/process_model.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/filter/update_tempering.h"
-#include "online_stereo_calibration/core/geometry/bearing_rotation_fit.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
 
 #include "calibration_filter_internal.h"
@@ -131,7 +130,6 @@ void CalibrationFilter::startCalibration(const StereoExtrinsics& guess) {
   excitation_.reset();
   monitor_.reset();
   time_since_opened_ = {0.0, 0.0};
-  rejection_streak_ = 0;
   ++starts_;
   points_.clear();
   index_.clear();
@@ -163,7 +161,8 @@ std::string CalibrationFilter::checkMotion(const MotionIncrement& m) const {
 }
 
 StepReport CalibrationFilter::step(const MotionIncrement& motion,
-                                   const std::vector<PointMeasurement>& measurements) {
+                                   const std::vector<PointMeasurement>& measurements,
+                                   const ChangeDetector& detect) {
   StepReport report;
   report.message = checkMotion(motion);
   if (!report.message.empty()) return report;  // untouched
@@ -196,9 +195,11 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
     }
     Vector6d estimated_motion_error;
     const bool final_pass = pass + 1 == passes;
+    // The gate is shown to the detector once, at the measured motion.
+    const ChangeDetector* detector = pass == 0 && detect ? &detect : nullptr;
     const bool completed = runPass(linearization, prior_motion_error, measurements, final_pass,
-                                   pass == 0, &report, &estimated_motion_error);
-    if (!completed || final_pass) break;  // a detected jump ends the step
+                                   detector, &report, &estimated_motion_error);
+    if (!completed || final_pass) break;  // a re-opening ends the step
     // Re-linearise at the corrected motion; the measured motion becomes a prior there.
     linearization.T_prev_curr = boxPlus(linearization.T_prev_curr, estimated_motion_error);
     prior_motion_error = boxMinus(motion.T_prev_curr, linearization.T_prev_curr);
@@ -229,7 +230,8 @@ bool CalibrationFilter::wantsMotionRelinearized(const MotionIncrement& motion) c
 
 bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& prior_motion_error,
                                 const std::vector<PointMeasurement>& measurements, bool final_pass,
-                                bool detect_jump, StepReport* out, Vector6d* motion_error) {
+                                const ChangeDetector* detect, StepReport* out,
+                                Vector6d* motion_error) {
   StepReport& report = *out;
   has_scores_ = false;
   // ---- prediction (Sec. II-B) ----
@@ -268,53 +270,34 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
     }
   }
 
-  // ---- gate outliers; many at once means the calibration itself jumped ----
+  // ---- gate outliers; a change detector (JumpTest) may re-open a block instead ----
   std::vector<const PointInnovation*> used;
-  int left_failures = 0;
   for (const PointInnovation& inn : innovations) {
     if (inn.nis <= config_.outlier_gate) {
       used.push_back(&inn);
     } else {
       report.outliers.push_back(points_[inn.point].id);
       remove[inn.point] = true;
-      if (inn.nis_left > kLeftGate) ++left_failures;
     }
   }
-  const int tested = static_cast<int>(innovations.size());
-  // The left image does not see x_camr: if it fails too, x_caml moved (via eq. 8).
-  const JumpBlock suspect = 2 * left_failures >= static_cast<int>(report.outliers.size())
-                                ? JumpBlock::kVehicleToLeft
-                                : JumpBlock::kLeftToRight;
-  const double rejected = static_cast<double>(report.outliers.size());
-  const bool enough_tested = tested >= config_.jump_min_points;
-  if (detect_jump) {
-    const bool partly =
-        enough_tested && rejected >= config_.jump_sustained_rejected_fraction * tested;
-    rejection_streak_ = partly ? rejection_streak_ + 1 : 0;
-  }
-  // Not while the suspect block is still settling: a start-up transient gates out many
-  // points for some frames too (default campaign run 180 re-opened x_camr at frame 32).
-  const bool sustained = config_.jump_sustained_frames > 0 &&
-                         rejection_streak_ >= config_.jump_sustained_frames &&
-                         time_since_opened_[blockIndex(suspect)] >= config_.jump_settle_time;
-  const bool at_once = rejected >= config_.jump_rejected_fraction * tested;
-  if (detect_jump && enough_tested && (at_once || sustained) && canReopen(suspect)) {
-    report.jump = suspect;
-    rejection_streak_ = 0;
-    if (shared) marginalizeMotionError(P);
-    report.message = "sudden calibration change detected";
-    // Only a jump found at once has all its tracked points measured across it; after a
-    // sustained test most were initialised after it.
-    const bool fitted = at_once && suspect == JumpBlock::kVehicleToLeft &&
-                        reopenLeftCameraAtFittedRotation(innovations, &report);
-    if (!fitted) reopenBlock(report.jump, &report);
-    report.lost.reserve(points_.size());
-    for (const TrackedPoint& point : points_) report.lost.push_back(point.id);
-    report.outliers.clear();
-    points_.clear();
-    index_.clear();
-    report.message += "; points re-initialised";
-    return false;
+  if (detect) {
+    GateOutcome gate;
+    gate.points.reserve(innovations.size());
+    for (const PointInnovation& inn : innovations) {
+      GatedPoint point;
+      point.predicted_left = inn.predicted.head<2>();
+      point.measured_left = point.predicted_left + inn.residual.head<2>();
+      point.S_left = inn.S.topLeftCorner<2, 2>();
+      point.nis_left = inn.nis_left;
+      point.gated_out = !(inn.nis <= config_.outlier_gate);
+      gate.points.push_back(point);
+    }
+    const Reopening reopening = (*detect)(gate);
+    if (reopening.block != JumpBlock::kNone) {
+      if (shared) marginalizeMotionError(P);
+      applyReopening(reopening, &report);
+      return false;
+    }
   }
 
   // ---- Kalman update of the global block with the points marginalised ----

@@ -18,7 +18,6 @@
 #include "online_stereo_calibration/core/filter/process_model.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/filter/update_tempering.h"
-#include "online_stereo_calibration/core/geometry/bearing_rotation_fit.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
 
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
@@ -40,9 +39,6 @@ inline double velocityBiasPriorSigma(const FilterConfig& config, int axis) {
   return axis == 0 ? config.odometry_forward_velocity_bias_sigma
                    : config.odometry_velocity_bias_sigma;
 }
-
-/// chi-square(2) at 99.9 %: the left image's share of a stereo innovation.
-inline constexpr double kLeftGate = 13.82;
 
 /// 0 for x_caml, 1 for x_camr (JumpBlock::kNone is not a block).
 inline size_t blockIndex(JumpBlock block) { return block == JumpBlock::kVehicleToLeft ? 0 : 1; }

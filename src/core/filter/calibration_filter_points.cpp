@@ -15,7 +15,6 @@
 #include "online_stereo_calibration/core/filter/process_model.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/filter/update_tempering.h"
-#include "online_stereo_calibration/core/geometry/bearing_rotation_fit.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
 
 #include "calibration_filter_internal.h"

@@ -88,12 +88,12 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   keepStereoMatchesForTheNextPair();
   feedHandEye(motion_since_last_processed);
   if (!seeded.empty()) {
-    result.estimator.right_rotation_from_stereo_fit = true;
-    result.estimator.warnings.insert(result.estimator.warnings.begin(), seeded);
+    result.estimator.events.addFirst(FrameEvent::kRightRotationFromStereoFit, seeded);
   }
   result.processed = true;
-  result.status = result.estimator.motion_rejected ? "processed (motion rejected, tracks reset)"
-                  : result.estimator.relinearized
+  result.status = result.estimator.has(FrameEvent::kMotionRejected)
+                      ? "processed (motion rejected, tracks reset)"
+                  : result.estimator.has(FrameEvent::kRelinearized)
                       ? "processed (restarted from the current estimate: re-linearised, tracks "
                         "reset)"
                   : !seeded.empty() ? "processed (" + seeded + ")"
@@ -104,7 +104,7 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   // Re-opening x_camr's rotation widens the band and lets the filter re-converge at once.
   double rotation_sigma = 0.0;
   std::string why;
-  const bool reopened_by_estimator = result.estimator.right_camera_off_epipolar_lines;
+  const bool reopened_by_estimator = result.estimator.has(FrameEvent::kRightCameraOffEpipolarLines);
   if (reopened_by_estimator) {
     // The estimator's own test of the pairs against the epipolar lines (its warning says how
     // far off they were); it re-opened x_camr already.

@@ -153,7 +153,8 @@ std::vector<ImageFrameResult> runImageScenario(
     r.processed = result.processed;
     r.front_end = result.front_end;
     if (result.stereo_fit_tried) r.stereo_fit = result.stereo_fit;
-    r.right_rotation_from_stereo_fit = result.estimator.right_rotation_from_stereo_fit;
+    r.right_rotation_from_stereo_fit =
+        result.estimator.has(FrameEvent::kRightRotationFromStereoFit);
     r.right_camera_reopened = result.right_camera_reopened;
     since_processed.reset();
     if (!result.processed) {

@@ -26,7 +26,7 @@ ScenarioFrameResult makeFrameResult(const SimulatedFrame& frame,
   r.new_points = report.new_points;
   r.jump_detected = report.step.jump != JumpBlock::kNone;
   r.tempering = report.step.tempering;
-  r.warnings = report.warnings;
+  r.warnings = report.events.texts();
   r.converged = isConverged(estimate, ConvergenceThresholds());
   r.time_ms = time_ms;
   r.time_offset = estimate.time_offset;

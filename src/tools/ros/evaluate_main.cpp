@@ -211,6 +211,14 @@ int evaluateBag(const Options& options) {
   std::vector<double> times;
   std::map<std::int64_t, sensor_msgs::ImageConstPtr> pending_left, pending_right;
   int frame = 0, skipped = 0;
+  // The estimator's events echoed to the progress output, each kind at most once every
+  // kEventRepeatPairs pairs (a baseline guess that triangulates nothing says so every pair).
+  struct EventEcho {
+    int last_pair = -1;
+    int suppressed = 0;
+  };
+  constexpr int kEventRepeatPairs = 50;
+  std::map<osc::FrameEvent, EventEcho> echoes;
   double previous_stamp = 0.0;
   bool have_previous = false;
   const auto start = std::chrono::steady_clock::now();
@@ -268,14 +276,19 @@ int evaluateBag(const Options& options) {
     }
     previous_stamp = stamp;
     have_previous = true;
-    // What the estimator did at a start far off (issue 14), in the progress output.
-    for (const std::string& warning : result.estimator.warnings) {
-      if ((result.estimator.right_rotation_from_stereo_fit &&
-           warning.rfind("right camera rotation from the stereo fit", 0) == 0) ||
-          (result.estimator.mounting_rotation_from_motion &&
-           warning.rfind("mounting rotation from motion", 0) == 0)) {
-        std::cerr << "\nevaluate: pair " << frame << ": " << warning << "\n";
+    // What the estimator's components did, and why it cannot learn (frame_event.h), in the
+    // progress output: each kind at most once every kEventRepeatPairs pairs.
+    for (const osc::FrameEventLine& event : result.estimator.events) {
+      EventEcho& echo = echoes[event.kind];
+      if (echo.last_pair >= 0 && frame - echo.last_pair < kEventRepeatPairs) {
+        ++echo.suppressed;
+        continue;
       }
+      std::cerr << "\nevaluate: pair " << frame << ": [" << osc::frameEventName(event.kind) << "] "
+                << event.text;
+      if (echo.suppressed > 0) std::cerr << " (and " << echo.suppressed << " times before)";
+      std::cerr << "\n";
+      echo = EventEcho{frame, 0};
     }
     osc::EstimateRow row;
     row.frame = frame;

@@ -16,6 +16,8 @@
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/baseline_from_motion.h"
 #include "online_stereo_calibration/core/estimator/epipolar_consistency.h"
+#include "online_stereo_calibration/core/estimator/frame_event.h"
+#include "online_stereo_calibration/core/estimator/jump_test.h"
 #include "online_stereo_calibration/core/estimator/left_camera_gap_check.h"
 #include "online_stereo_calibration/core/estimator/mounting_from_motion.h"
 #include "online_stereo_calibration/core/estimator/restart_from_estimate.h"
@@ -59,55 +61,22 @@ struct CalibrationEstimate {
 
 /// What happened to one image pair.
 struct FrameReport {
-  bool motion_rejected = false;  ///< the motion was unusable: points dropped, calibration kept
-  StepReport step;               ///< the filter step (empty for the first pair)
-  /// x_camr's rotation was contradicted by the updates beyond its covariance and its variance
-  /// widened to cover the indicated shift, points kept (right_camera_score_test.h; the
-  /// warning says by how much).
-  bool right_rotation_widened = false;
+  StepReport step;  ///< the filter step (empty for the first pair)
+  /// What the components did in this frame and what they found wrong, one line each, in
+  /// order (frame_event.h): re-openings, restarts, widenings, a rejected motion, a baseline
+  /// guess no point triangulates with, ...
+  FrameEvents events;
   int new_points = 0;            ///< points initialised from this pair
   int rejected_new_points = 0;   ///< candidate points that did not triangulate in range
   int invalid_observations = 0;  ///< non-finite pixels or sigmas
   /// Points no longer in the filter (lost, outliers, reset): a tracker should forget them.
   std::vector<PointId> dropped;
-  /// The filter was restarted from the current estimate with its start's covariance (it had
-  /// moved far from where it was linearised: FilterConfig::relinearization_*).
-  bool relinearized = false;
-  /// Stereo pairs came, but not one point could be initialised and the filter has none (the
-  /// left->right estimate triangulates none within the depth range: a baseline guess far off).
-  bool no_point_initialised = false;
-  /// x_caml was restarted from its rotation determined from the vehicle's and the left
-  /// camera's motion (FilterConfig::hand_eye_start; the warning names the old and new
-  /// roll/pitch/yaw); tracks reset.
-  bool mounting_rotation_from_motion = false;
-  /// x_camr's rotation was re-seeded from a whole-image stereo fit at a start or after a
-  /// re-opening (CalibrationPipeline, FilterConfig::stereo_fit_start; the warning names the
-  /// old and new angles and the distance); tracks reset.
-  bool right_rotation_from_stereo_fit = false;
   /// Fewer stereo pairs (tracked and new) than FilterConfig::min_points_to_update: the
   /// calibration was predicted, not updated, and the tracked points start afresh (the
-  /// warning is given in the first such pair of a stretch).
+  /// event kTooFewPoints is given in the first such pair of a stretch).
   bool too_few_points = false;
-  /// Every tracked point was measured in both images, yet none could be predicted (some sigma
-  /// point of it behind a camera: its depth or x_camr's rotation far too uncertain), in 10
-  /// pairs in a row: nothing is learned while it lasts. Set (and warned) in the pair that
-  /// completes such a stretch.
-  bool no_point_measurable = false;
-  /// x_camr's translation was restarted with the baseline's length measured from the left
-  /// camera's motion (FilterConfig::baseline_from_motion; no point could be initialised with
-  /// the guess's; the warning names the old and new length); tracks reset.
-  bool baseline_from_motion = false;
-  /// x_camr's rotation was re-opened before this pair's update: the stereo pairs had left its
-  /// epipolar lines for FilterConfig::epipolar_knock_pairs pairs in a row (a knocked right
-  /// camera; the warning names the statistic and the indicated rotation); every point
-  /// forgotten, this pair's initialised afresh.
-  bool right_camera_off_epipolar_lines = false;
-  /// x_caml was re-opened after this pair's update: the first updates after a stretch of at
-  /// least FilterConfig::unobserved_gap_s without a point measured disagreed with it (the
-  /// consistency monitor's x_caml statistic above its bound; a change of the mounting while
-  /// nothing was seen); every point forgotten, this pair's initialised afresh.
-  bool left_camera_reopened_after_gap = false;
-  std::vector<std::string> warnings;  ///< human-readable, one per problem
+
+  bool has(FrameEvent kind) const { return events.has(kind); }
 };
 
 /// Online stereo extrinsic calibration from stereo observations and vehicle motion.
@@ -241,6 +210,8 @@ class StereoCalibrationEstimator {
   /// Linearisation guard: the restart from the estimate after a start or re-opening far off.
   RestartFromEstimate restart_;
   /// Change detection, x_camr: its rotation widened on the evidence of the updates' score.
+  /// Change detection at the filter's gate: many points gated out, a block jumped.
+  JumpTest jump_test_;
   RightCameraScoreTest score_test_;
   /// Change detection, x_caml: tested when points come back after a stretch without any.
   LeftCameraGapCheck gap_check_;

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -70,6 +71,35 @@ inline Vector6d uniformBlockSigmas(double translation_sigma, double rotation_sig
   return sigma;
 }
 
+/// One tested point at a step's outlier gate, as a change detector sees it (JumpTest).
+struct GatedPoint {
+  Eigen::Vector2d predicted_left = Eigen::Vector2d::Zero();  ///< undistorted px
+  Eigen::Vector2d measured_left = Eigen::Vector2d::Zero();   ///< undistorted px
+  Eigen::Matrix2d S_left = Eigen::Matrix2d::Identity();      ///< left 2x2 of the innovation cov.
+  double nis_left = 0.0;   ///< the left image's share of the normalised innovation squared
+  bool gated_out = false;  ///< beyond FilterConfig::outlier_gate
+};
+
+/// What the outlier gate of a step's first pass saw, before the update.
+struct GateOutcome {
+  std::vector<GatedPoint> points;  ///< every measured point that could be linearised
+};
+
+/// A change detector's verdict: re-open @p block before the update (which is then skipped
+/// and every point dropped), or nothing (kNone).
+struct Reopening {
+  JumpBlock block = JumpBlock::kNone;
+  /// The block's [dt (3), dtheta (3)] sigmas; each keeps its earlier sigma where larger.
+  Vector6d sigma = Vector6d::Zero();
+  /// x_caml's rotation moves R_veh_caml -> R_veh_caml * turn first (a fitted turn).
+  bool turned = false;
+  Eigen::Matrix3d turn = Eigen::Matrix3d::Identity();
+  std::string message;  ///< the event's line
+};
+
+/// Looks at a step's gate before its update (CalibrationFilter::step).
+using ChangeDetector = std::function<Reopening(const GateOutcome&)>;
+
 /// What one filter step did.
 struct StepReport {
   bool accepted = false;              ///< false: the input was rejected and nothing changed
@@ -115,7 +145,11 @@ class CalibrationFilter {
   /// Predicts with the measured motion (eq. 7-28) and corrects with the measurements
   /// (eq. 29-30). Tracked points without a measurement are removed (Sec. II-C), and so
   /// are outliers. A rejected motion leaves the filter untouched (report.accepted false).
-  StepReport step(const MotionIncrement& motion, const std::vector<PointMeasurement>& measurements);
+  /// @p detect, when given, sees the first pass's gate before the update; when it returns
+  /// a block, the block is re-opened as it says, every point is dropped and the step ends
+  /// without an update (report.jump).
+  StepReport step(const MotionIncrement& motion, const std::vector<PointMeasurement>& measurements,
+                  const ChangeDetector& detect = ChangeDetector());
 
   /// Where each tracked point will be seen after the motion, with its innovation
   /// covariance (for the tracker's search windows, Sec. II-C). The filter is not changed.
@@ -140,6 +174,10 @@ class CalibrationFilter {
   /// was started or widened (while as uncertain as a re-opened block, many gated-out points are
   /// the start-up transient, not a change).
   bool canReopen(JumpBlock block) const;
+  /// s of accepted motion since @p block was started or widened.
+  double timeSinceOpened(JumpBlock block) const {
+    return time_since_opened_[block == JumpBlock::kVehicleToLeft ? 0 : 1];
+  }
   /// Adds @p added (rad^2, per axis) to the variances of @p block's rotation; mean, points and
   /// correlations kept (a widening on evidence, not a re-opening).
   void widenRotationVariance(JumpBlock block, const Eigen::Vector3d& added);
@@ -229,11 +267,11 @@ class CalibrationFilter {
   /// (FilterConfig::motion_relinearizations): the vehicle is slower than 2 m/s.
   bool wantsMotionRelinearized(const MotionIncrement& motion) const;
   /// One predict + update linearised at `motion` with the given prior mean of the motion
-  /// error; a non-final pass only estimates the motion error. False: a jump was detected
-  /// (the step is complete then).
+  /// error; a non-final pass only estimates the motion error. @p detect (may be null) sees
+  /// the gate before the update. False: a block was re-opened (the step is complete then).
   bool runPass(const MotionIncrement& motion, const Vector6d& prior_motion_error,
-               const std::vector<PointMeasurement>& measurements, bool final_pass, bool detect_jump,
-               StepReport* report, Vector6d* motion_error);
+               const std::vector<PointMeasurement>& measurements, bool final_pass,
+               const ChangeDetector* detect, StepReport* report, Vector6d* motion_error);
   /// Drift, motion-error augmentation and point prediction; returns the global covariance
   /// (12, or 18 with the step's motion error) and marks points that could not be predicted.
   /// The prediction (drift, points) from the current state; remember: keep it in
@@ -249,16 +287,9 @@ class CalibrationFilter {
   void predictPoints(const MotionIncrement& motion, const Eigen::MatrixXd& P_global,
                      std::vector<bool>* failed);
   void marginalizeMotionError(const Eigen::MatrixXd& P_global);
-  /// widenBlock with the config's jump sigmas (the points are the caller's); sets
-  /// report->jump_sigma.
-  void reopenBlock(JumpBlock block, StepReport* report);
-  /// After an x_caml jump found at once: x_caml's rotation moved by the rotation that takes
-  /// the tracked points' predicted left bearings onto the measured ones, and only the axes
-  /// that moved re-opened wide (FilterConfig::jump_fit_rotation_sigma). False (nothing
-  /// changed) when off, when the fit fails or when the turn does not explain at least
-  /// jump_rejected_fraction of the points; then the whole block is re-opened.
-  bool reopenLeftCameraAtFittedRotation(const std::vector<PointInnovation>& innovations,
-                                        StepReport* report);
+  /// Applies a change detector's verdict inside a step: x_caml's turn, the block widened,
+  /// every point dropped into report->lost.
+  void applyReopening(const Reopening& reopening, StepReport* report);
   /// Widens the block's variances to at least @p sigma^2 (per component) and decorrelates it.
   void widenBlock(JumpBlock block, const Vector6d& sigma);
   void removeIndices(const std::vector<bool>& remove);
@@ -287,8 +318,6 @@ class CalibrationFilter {
   /// s of accepted motion since each block (x_caml, x_camr) was started or widened
   /// (canReopen).
   std::array<double, 2> time_since_opened_ = {0.0, 0.0};
-  /// Frames in a row with at least jump_sustained_rejected_fraction of the points gated out.
-  int rejection_streak_ = 0;
   /// Starts so far (startCalibration).
   int starts_ = 0;
   PointCoordinates coordinates_;  ///< how TrackedPoint::mean stores a point

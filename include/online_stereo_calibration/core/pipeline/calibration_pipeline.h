@@ -48,11 +48,11 @@ struct PipelineResult {
   /// refined pairs of this and the previous pair off their epipolar lines by far more than
   /// x_camr's sigma allows.
   /// x_camr's rotation was re-opened and tracking restarted (also when the estimator found
-  /// the pairs off x_camr's epipolar lines: estimator.right_camera_off_epipolar_lines).
+  /// the pairs off x_camr's epipolar lines: estimator's event kRightCameraOffEpipolarLines).
   bool right_camera_reopened = false;
   /// The whole-image stereo fit at a start was tried in this pair
   /// (FilterConfig::stereo_fit_start); stereo_fit is its seed (valid if the fit was), and
-  /// estimator.right_rotation_from_stereo_fit says whether x_camr's rotation was re-seeded.
+  /// the estimator's event kRightRotationFromStereoFit says whether x_camr's rotation was re-seeded.
   bool stereo_fit_tried = false;
   RightRotationSeed stereo_fit;
   double processing_time = 0.0;  ///< seconds spent on this pair (front end + filter)

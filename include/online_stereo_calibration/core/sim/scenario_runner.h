@@ -31,8 +31,8 @@ struct ScenarioFrameResult {
   bool jump_detected = false;
   /// The step's update tempering factor (StepReport::tempering; 1 = untempered).
   double tempering = 1.0;
-  /// The estimator's warnings for this frame (FrameReport::warnings: restarts, re-openings,
-  /// re-seeds, rejected motion), for a run's event log.
+  /// The text of the frame's events (FrameReport::events: restarts, re-openings, re-seeds,
+  /// rejected motion), for a run's event log.
   std::vector<std::string> warnings;
   /// isConverged(estimate, ConvergenceThresholds()) after this frame (convergence.h).
   bool converged = false;
