@@ -6,7 +6,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include "online_stereo_calibration/core/estimator/jump_test.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
+#include "online_stereo_calibration/core/filter/consistency_monitor.h"
 #include "online_stereo_calibration/core/filter/dense_calibration_ukf.h"
 
 namespace osc {
@@ -61,18 +63,25 @@ Matrix12d convergedCovariance() {
 }
 
 /// One structured step with @p config (the shipped defaults, or the consistency monitor off),
-/// @p forward_step metres in 0.1 s.
+/// @p forward_step metres in 0.1 s, as the estimator makes it: the jump test shown the gate,
+/// the consistency monitor fed the update's scores.
 void structuredFilterStep(benchmark::State& state, const FilterConfig& config,
                           double forward_step = 0.35) {
   const BenchmarkProblem problem(static_cast<int>(state.range(0)), forward_step);
   CalibrationFilter prepared(config, problem.K);
   prepared.reset(problem.truth, convergedCovariance());
   for (const auto& m : problem.first) prepared.addPoint(m);
+  const ConsistencyMonitor prepared_monitor(config);
   for (auto _ : state) {
     state.PauseTiming();
     CalibrationFilter filter = prepared;
+    ConsistencyMonitor monitor = prepared_monitor;
+    JumpTest jump_test(JumpTestOptions::from(config));
     state.ResumeTiming();
-    benchmark::DoNotOptimize(filter.step(problem.motion, problem.second));
+    benchmark::DoNotOptimize(
+        filter.step(problem.motion, problem.second,
+                    [&](const GateOutcome& gate) { return jump_test.decide(gate, filter); }));
+    monitor.addUpdate(problem.motion.dt, filter.lastUpdateScores());
   }
   state.counters["points"] = static_cast<double>(prepared.pointCount());
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "online_stereo_calibration/core/estimator/baseline_from_motion.h"
+#include "online_stereo_calibration/core/estimator/baseline_restart.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
 
 namespace osc {
@@ -153,6 +154,68 @@ TEST(BaselineFromMotion, AStandingCameraTellsNothing) {
   const BaselineLength length = estimator.estimate();
   EXPECT_FALSE(length.valid);
   EXPECT_NE(length.why.find("0 pairs"), std::string::npos) << length.why;
+}
+
+/// A filter whose x_camr says the right camera is 3 cm to the side (the 0.3 m rig guessed 10x
+/// short), with @p translation_sigma on x_camr's translation.
+CalibrationFilter shortRigFilter(double translation_sigma) {
+  StereoIntrinsics k;
+  k.K_left << kFocal, 0, 0, 0, kFocal, 0, 0, 0, 1;
+  k.K_right = k.K_left;
+  CalibrationFilter filter(FilterConfig(), k);
+  StereoExtrinsics guess;
+  guess.T_caml_camr.translation() = Eigen::Vector3d(0.0, -0.03, 0.0);  // body: right is -y
+  Vector12d sigma = Vector12d::Constant(1e-3);
+  sigma.segment<3>(6).setConstant(translation_sigma);
+  filter.reset(guess, sigma.array().square().matrix().asDiagonal());
+  return filter;
+}
+
+/// Feeds @p pairs pairs of the drive as given links (normalised -> pixels at kFocal) and
+/// returns the last proposal.
+BaselineReseed drive(BaselineRestart* restart, const CalibrationFilter& filter, int pairs) {
+  std::mt19937 rng(7);
+  const Drive scene;
+  MotionIncrement motion;
+  motion.dt = 0.1;
+  motion.T_prev_curr.translation() = Eigen::Vector3d(scene.step, 0.0, 0.0);
+  BaselineReseed reseed;
+  for (int k = 0; k < pairs && !reseed.reseed; ++k) {
+    std::vector<std::pair<PointMeasurement, PointMeasurement>> links;
+    for (const StereoLink& link : scene.pair(&rng)) {
+      PointMeasurement a, b;
+      a.z = kFocal * link.previous;
+      b.z = kFocal * link.current;
+      links.emplace_back(a, b);
+    }
+    restart->setLinks(std::move(links), true);
+    reseed = restart->afterPair(motion, true, {}, filter);
+  }
+  return reseed;
+}
+
+// A length the filter does not know (3 cm guessed, 10 cm sigma) is restarted at the length from
+// motion along the guess's direction, with that length's sigma along it; a length it knows
+// (1 mm sigma) is not: then something else keeps the points out.
+TEST(BaselineRestart, AnUnknownLengthIsRestartedAtTheMeasuredOneAKnownOneIsNot) {
+  const CalibrationFilter unknown = shortRigFilter(0.1);
+  BaselineRestart restart(FilterConfig(), unknown.intrinsics().K_left,
+                          unknown.intrinsics().K_right);
+  const BaselineReseed reseed = drive(&restart, unknown, 8);
+  ASSERT_TRUE(reseed.reseed);
+  const Eigen::Vector3d t = reseed.T_caml_camr.translation();
+  EXPECT_NEAR(t.norm(), 0.3, 0.03);
+  EXPECT_LT(std::abs(t.x()) + std::abs(t.z()), 1e-12) << "along the guess's direction";
+  const double along = std::sqrt(reseed.covariance(1, 1));
+  EXPECT_GE(along, 0.05 * t.norm() - 1e-12);  // at least 5 % of the length
+  EXPECT_LT(along, 0.05);
+  EXPECT_NE(reseed.message.find("baseline length from motion: x_camr's translation restarted"),
+            std::string::npos)
+      << reseed.message;
+
+  const CalibrationFilter known = shortRigFilter(0.001);
+  BaselineRestart kept(FilterConfig(), known.intrinsics().K_left, known.intrinsics().K_right);
+  EXPECT_FALSE(drive(&kept, known, 8).reseed);
 }
 
 }  // namespace

@@ -66,7 +66,8 @@ BaselineReseed BaselineRestart::afterPair(const MotionIncrement& motion, bool mo
     if (!links_given_ && previous != previous_candidates_.end())
       links.push_back({previous->second, current[m.id]});
   }
-  for (const auto& [previous, now] : given_links_) links.push_back({normalised(previous), normalised(now)});
+  for (const auto& [previous, now] : given_links_)
+    links.push_back({normalised(previous), normalised(now)});
   previous_candidates_.swap(current);
   given_links_.clear();
   links_given_ = false;

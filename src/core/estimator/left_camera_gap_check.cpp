@@ -16,12 +16,12 @@ LeftCameraGapCheckOptions LeftCameraGapCheckOptions::from(const FilterConfig& co
   return o;
 }
 
-void LeftCameraGapCheck::beforeStep(CalibrationFilter* filter, bool has_tracked) {
+void LeftCameraGapCheck::beforeStep(ConsistencyMonitor* monitor, bool has_tracked) {
   const bool resumes_after_gap =
       options_.gap > 0.0 && unobserved_time_ >= options_.gap && has_tracked;
   if (!resumes_after_gap) return;
   // What the monitor saw before the stretch says nothing of what follows it.
-  filter->forgetConsistencyEvidence();
+  monitor->forgetEvidence();
   check_left_ = options_.window;
 }
 
@@ -35,13 +35,13 @@ void LeftCameraGapCheck::countAfterStep(const MotionIncrement& motion, const Ste
 
 GapDecision LeftCameraGapCheck::checkAfterStep(CalibrationFilter* filter,
                                                const MotionIncrement& motion,
-                                               const StepReport& step) {
+                                               const StepReport& step,
+                                               const ConsistencyStatus& consistency) {
   GapDecision decision;
   if (!(check_left_ > 0.0) || step.measurements_used == 0) return decision;
   check_left_ -= motion.dt;
   // A few updates at least: one update's score is dominated by its own noise.
   constexpr int kLeastUpdates = 3;
-  const ConsistencyStatus& consistency = step.consistency;
   const int caml = static_cast<int>(ConsistencyBlock::kVehicleToLeft);
   if (!consistency.exceeded[caml] || consistency.window_updates < kLeastUpdates) return decision;
   check_left_ = 0.0;

@@ -19,27 +19,11 @@ namespace {
 constexpr int kUnmeasurablePairsToWarn = 10;
 /// Fewest refused stereo pairs for which "no point could be initialised" is worth a warning.
 constexpr int kFewestPairsToExplain = 10;
-/// The baseline's length from motion restarts x_camr only while the length's 1 sigma is above
-/// this share of it (a 0.3 m rig: 9 cm; the guess's sigma points then reach below half the
-/// length). Measured on the default campaign: without it, run 90 (its points kept out by x_caml
-/// 20 deg off) was restarted at the right length with x_camr's wrong rotation, 570 frames
-/// beyond 5 sigma.
-constexpr double kUnknownLengthShare = 0.3;
-/// The least 1 sigma of a length from motion, as a share of it (the fit's own sigma is doubled).
-constexpr double kLeastLengthSigma = 0.05;
-
 StereoIntrinsics stereoIntrinsics(const CameraModel& left, const CameraModel& right) {
   StereoIntrinsics k;
   k.K_left = left.K();
   k.K_right = right.K();
   return k;
-}
-
-BaselineFromMotionConfig baselineConfig(const FilterConfig& config, const CameraModel& left) {
-  BaselineFromMotionConfig b;
-  b.pixel_noise = config.pixel_noise;
-  b.motion.focal = left.K()(0, 0);
-  return b;
 }
 
 HandEyeRotationConfig handEyeConfig(const FilterConfig& config) {
@@ -67,14 +51,28 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
       knock_test_(EpipolarKnockOptions::from(config)),
       guess_(initial_guess),
       mounting_(left_, handEyeConfig(config)),
-      baseline_from_motion_(baselineConfig(config, left_)) {
+      baseline_restart_(config, left_.K(), right_.K()),
+      monitor_(config) {
   filter_.reset(initial_guess);
+  followFilter();
   guess_covariance_ = filter_.covariance();
   restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
 }
 
+void StereoCalibrationEstimator::followFilter() {
+  if (filter_.starts() != monitor_starts_) {
+    monitor_starts_ = filter_.starts();
+    monitor_reopenings_ = filter_.reopenings();
+    monitor_.reset();
+  } else if (filter_.reopenings() != monitor_reopenings_) {
+    monitor_reopenings_ = filter_.reopenings();
+    monitor_.clearWindow();  // the evidence was the re-opened block's old calibration
+  }
+}
+
 bool StereoCalibrationEstimator::restartIfLinearizedFarOff(FrameReport* report) {
   const RestartDecision decision = restart_.checkAfterStep(&filter_, report->step);
+  followFilter();
   if (!decision.restarted) return false;
   report->dropped.insert(report->dropped.end(), decision.dropped.begin(), decision.dropped.end());
   report->events.add(FrameEvent::kRelinearized, decision.warning);
@@ -114,6 +112,7 @@ bool StereoCalibrationEstimator::restartFromMotion(
       Eigen::Matrix3d::Identity() * translation_sigma * translation_sigma;
   covariance.template block<3, 3>(kCaml + kRotation, kCaml + kRotation) = restart.covariance;
   filter_.reset(start, covariance);
+  followFilter();
   // A start: both blocks re-linearised as after one.
   restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
   const Eigen::Vector3d before = rpyFromRotation(now.T_veh_caml.linear()) * 180.0 / M_PI;
@@ -214,11 +213,18 @@ FrameReport StereoCalibrationEstimator::processFrame(
       tracked.clear();
     }
     held_for_few_points_ = report.too_few_points;
-    gap_check_.beforeStep(&filter_, !tracked.empty());
+    gap_check_.beforeStep(&monitor_, !tracked.empty());
+    filter_.setDriftInflation({monitor_.inflation(ConsistencyBlock::kVehicleToLeft),
+                               monitor_.inflation(ConsistencyBlock::kLeftToRight)});
     report.step = filter_.step(motion, tracked, [this](const GateOutcome& gate) {
       return jump_test_.decide(gate, filter_);
     });
     gap_check_.countAfterStep(motion, report.step);
+    if (report.step.accepted) {
+      followFilter();  // a jump's re-opening ends the monitor's window before its update
+      monitor_.addUpdate(motion.dt, filter_.lastUpdateScores());
+      report.consistency = monitor_.status();
+    }
     if (!report.step.accepted) {
       // Without a usable motion the points cannot be predicted: start tracking afresh.
       report.events.add(FrameEvent::kMotionRejected, "motion rejected: " + report.step.message);
@@ -283,7 +289,7 @@ FrameReport StereoCalibrationEstimator::processFrame(
             << "(baseline yr " << e.parameters(7) << " m, 1 sigma " << e.sigmas()(7)
             << " m); check the baseline guess and initial_camr_translation_sigma_m";
     if (config_.baseline_from_motion != 0) {
-      const BaselineLength length = baseline_from_motion_.estimate();
+      const BaselineLength length = baseline_restart_.lengthSoFar();
       message << "; measuring the baseline's length from the left camera's motion ("
               << (length.valid ? "so far " + std::to_string(length.length) + " m" : length.why)
               << ")";
@@ -294,7 +300,7 @@ FrameReport StereoCalibrationEstimator::processFrame(
     learnBaselineLength(motion, follows_previous_pair && !report.has(FrameEvent::kMotionRejected),
                         candidates, &report);
   } else {
-    forgetBaselineEvidence();
+    baseline_restart_.forget();
   }
   // A point re-initialised from this pair (after a jump or a motion reset) is not dropped.
   std::vector<PointId> still_dropped;
@@ -320,119 +326,32 @@ bool StereoCalibrationEstimator::reopenIfOffEpipolarLines(std::vector<PointMeasu
   return true;
 }
 
-void StereoCalibrationEstimator::forgetBaselineEvidence() {
-  baseline_from_motion_.clear();
-  previous_candidates_.clear();
-  given_links_.clear();
+void StereoCalibrationEstimator::linkStereoMatches(
+    const std::vector<std::pair<StereoObservation, StereoObservation>>& links) {
+  std::vector<std::pair<PointMeasurement, PointMeasurement>> measured;
+  for (const auto& [previous, now] : links) {
+    PointMeasurement a, b;
+    if (toMeasurement(previous, &a) && toMeasurement(now, &b)) measured.emplace_back(a, b);
+  }
+  baseline_restart_.setLinks(std::move(measured), !links.empty());
 }
 
-bool StereoCalibrationEstimator::learnBaselineLength(
+void StereoCalibrationEstimator::learnBaselineLength(
     const MotionIncrement& motion, bool motion_links_pairs,
     const std::vector<PointMeasurement>& candidates, FrameReport* report) {
-  const Eigen::Matrix3d K_left_inverse = left_.K().inverse(),
-                        K_right_inverse = right_.K().inverse();
-  const auto normalised = [&](const PointMeasurement& m) {
-    Eigen::Vector4d n;
-    n << (K_left_inverse * m.z.head<2>().homogeneous()).head<2>(),
-        (K_right_inverse * m.z.tail<2>().homogeneous()).head<2>();
-    return n;
-  };
-  std::unordered_map<PointId, Eigen::Vector4d> current;
-  std::vector<StereoLink> links;
-  for (const PointMeasurement& m : candidates) {
-    current[m.id] = normalised(m);
-    const auto previous = previous_candidates_.find(m.id);
-    if (given_links_.empty() && previous != previous_candidates_.end())
-      links.push_back({previous->second, current[m.id]});
-  }
-  for (const auto& [previous, now] : given_links_) {
-    PointMeasurement a, b;
-    if (toMeasurement(previous, &a) && toMeasurement(now, &b))
-      links.push_back({normalised(a), normalised(b)});
-  }
-  previous_candidates_.swap(current);
-  given_links_.clear();
-  if (!motion_links_pairs || links.empty()) return false;
-  // The left camera's motion between the pairs, at the odometry's scale (its length hardly
-  // depends on x_caml: only through the lever arm of the vehicle's rotation).
-  const Eigen::Isometry3d& T_veh_caml = filter_.extrinsics().T_veh_caml;
-  const double moved =
-      (T_veh_caml.inverse() * motion.T_prev_curr * T_veh_caml).translation().norm();
-  baseline_from_motion_.addPair(links, filter_.extrinsics().leftToRightOptical(), moved);
-  const BaselineLength length = baseline_from_motion_.estimate();
-  if (!length.valid) return false;
-  forgetBaselineEvidence();
-  // The seed's sigma: twice the fit's (the pairs' motion fits err in common, which the
-  // per-point sigmas do not see) and at least 5 % of the length.
-  const double sigma = std::max(2.0 * length.sigma, kLeastLengthSigma * length.length);
-  using namespace layout;
-  const Eigen::Vector3d t = filter_.extrinsics().T_caml_camr.translation();
-  const double old_length = t.norm();
-  if (!(old_length > 0.0)) return false;  // no direction to put the length along
-  const Matrix12d P = filter_.covariance();
-  const Eigen::Vector3d c = t / old_length;
-  const double old_sigma =
-      std::sqrt(c.dot(P.block<3, 3>(kCamr + kTranslation, kCamr + kTranslation) * c));
-  // Only a length the filter does not know: then its sigma points reach almost no baseline and
-  // no point passes the depth check. With a length it knows, the points are kept out by
-  // something else (x_caml or x_camr's rotation far off; default campaign run 90), which a
-  // restart of x_camr from the current estimate would lock in.
-  const bool offset_significant = std::abs(length.offset) > 3.0 * length.offset_sigma;
-  if (!(old_sigma > kUnknownLengthShare * old_length) || !(sigma < 0.5 * old_sigma)) {
-    // The length known, something else keeps the pairs out. (Turning x_camr by the disparity
-    // offset then measured mixed: docs/experiments.md, disparity_offset_turn.)
-    return false;
-  }
-  // The length along the baseline's direction; across it the translation's covariance as it
-  // was, in metres: the length says nothing about it. (Scaled with the length, as a direction
-  // uncertainty, it grew tenfold for an 11 cm rig guessed at 1 cm: 1.1 m across a 0.11 m
-  // baseline, which no linearisation follows; one of 16 seeds of that start locked in the
-  // baseline's direction 75 deg off, xr 14 sigma, and three more ended not honest:
-  // docs/RESULTS.md "Session 38".) Only a shorter length scales it down with the baseline.
-  const double ratio = std::min(1.0, length.length / old_length);
-  const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - c * c.transpose();
-  Matrix6d block = P.block<6, 6>(kCamr, kCamr);
-  block.topLeftCorner<3, 3>() = ratio * ratio * across * block.topLeftCorner<3, 3>() * across +
-                                sigma * sigma * c * c.transpose();
-  block.topRightCorner<3, 3>() = ratio * across * block.topRightCorner<3, 3>();
-  block.bottomLeftCorner<3, 3>() = block.topRightCorner<3, 3>().transpose();
-  Eigen::Isometry3d T_caml_camr = filter_.extrinsics().T_caml_camr;
-  T_caml_camr.translation() = length.length * c;
-  // The offset is x_camr's rotation about the axis across the baseline and the view being off
-  // (yaw_r for a horizontal rig; the stereo fit at a start hardly determines it): re-centred
-  // when significant, its sigma kept (the filter linearises near the truth, and nothing it
-  // did not learn is claimed).
-  const bool turned = offset_significant;
-  if (turned) T_caml_camr.linear() = rightCameraTurnedByDisparityOffset(length.offset).linear();
-  for (PointId id : reseedRightCamera(T_caml_camr, block, true)) report->dropped.push_back(id);
-  std::ostringstream message;
-  message.precision(3);
-  message << "baseline length from motion: x_camr's translation restarted at " << length.length
-          << " m, 1 sigma " << sigma << " m (was " << old_length << " m, 1 sigma " << old_sigma
-          << " m; " << length.inliers << " points in " << length.pairs
-          << " pairs of the left camera's motion)";
-  message << "; disparity offset " << length.offset * 180.0 / M_PI << " deg, 1 sigma "
-          << length.offset_sigma * 180.0 / M_PI << " deg"
-          << (turned ? ": x_camr turned by it about the axis across the baseline and the view"
-                     : "");
-  message << "; tracks reset";
-  report->events.add(FrameEvent::kBaselineFromMotion, message.str());
-  return true;
-}
-
-Eigen::Isometry3d StereoCalibrationEstimator::rightCameraTurnedByDisparityOffset(
-    double offset) const {
-  const Eigen::Matrix3d& R_bo = rotationBodyOptical();
-  const Eigen::Isometry3d T_lopt_ropt =
-      withoutDisparityOffset(filter_.extrinsics().leftToRightOptical(), offset);
-  Eigen::Isometry3d T_caml_camr = filter_.extrinsics().T_caml_camr;
-  T_caml_camr.linear() = R_bo * T_lopt_ropt.linear() * R_bo.transpose();
-  return T_caml_camr;
+  const BaselineReseed reseed =
+      baseline_restart_.afterPair(motion, motion_links_pairs, candidates, filter_);
+  if (!reseed.reseed) return;
+  for (PointId id : reseedRightCamera(reseed.T_caml_camr, reseed.covariance, true))
+    report->dropped.push_back(id);
+  report->events.add(FrameEvent::kBaselineFromMotion, reseed.message);
 }
 
 bool StereoCalibrationEstimator::reopenLeftCameraAfterGap(const MotionIncrement& motion,
                                                           FrameReport* report) {
-  const GapDecision decision = gap_check_.checkAfterStep(&filter_, motion, report->step);
+  const GapDecision decision =
+      gap_check_.checkAfterStep(&filter_, motion, report->step, report->consistency);
+  followFilter();
   if (!decision.reopened) return false;
   report->dropped.insert(report->dropped.end(), decision.dropped.begin(), decision.dropped.end());
   restart_.anchorReopening(filter_, JumpBlock::kVehicleToLeft, decision.sigma);
@@ -453,6 +372,7 @@ std::vector<PointId> StereoCalibrationEstimator::reopenRightCameraRotation(doubl
   has_previous_frame_ = false;
   const Vector6d sigma = uniformBlockSigmas(0.0, rotation_sigma);
   std::vector<PointId> dropped = filter_.reopen(JumpBlock::kLeftToRight, sigma);
+  followFilter();
   restart_.anchorReopening(filter_, JumpBlock::kLeftToRight, sigma);
   return dropped;
 }
@@ -478,6 +398,7 @@ std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
   StereoExtrinsics seeded = filter_.extrinsics();
   seeded.T_caml_camr = T_caml_camr;
   filter_.reset(seeded, withRightCamera(filter_.covariance(), covariance));
+  followFilter();
   // Only a start's seed becomes the guess a hand-eye restart returns to. One after a
   // re-opening keeps the translation the filter learned before it, which, before the hand-eye
   // has found x_caml's rotation, was learned with x_caml far off: a backward camera guessed
@@ -487,7 +408,7 @@ std::vector<PointId> StereoCalibrationEstimator::reseedRightCamera(
     guess_.T_caml_camr = T_caml_camr;
     guess_covariance_ = withRightCamera(Matrix12d(guess_covariance_), covariance);
   }
-  forgetBaselineEvidence();  // its disparities were measured with the old x_camr
+  baseline_restart_.forget();  // its disparities were measured with the old x_camr
   has_previous_frame_ = false;
   mounting_.forgetFrame();
   if (start) {
@@ -526,7 +447,7 @@ void StereoCalibrationEstimator::warnIfNoPointMeasurable(
 }
 
 void StereoCalibrationEstimator::forgetDriveEvidence() {
-  forgetBaselineEvidence();
+  baseline_restart_.forget();
   held_for_few_points_ = false;
   unmeasurable_pairs_ = 0;
   knock_test_.reset();
@@ -538,6 +459,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
   guess_ = guess;
   forgetDriveEvidence();
   filter_.reset(guess);
+  followFilter();
   guess_covariance_ = filter_.covariance();
   has_previous_frame_ = false;
   restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
@@ -556,6 +478,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
   filter_.reset(guess, scale.isZero() || internal.llt().info() != Eigen::Success
                            ? tangent_covariance
                            : Matrix12d(0.5 * (internal + internal.transpose())));
+  followFilter();
   guess_covariance_ = filter_.covariance();
   has_previous_frame_ = false;
   restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
@@ -584,7 +507,7 @@ CalibrationEstimate StereoCalibrationEstimator::estimate() const {
   e.parameter_covariance += e.odometry_scale_covariance;
   e.tracked_points = filter_.pointCount();
   e.excitation = filter_.excitationGains();
-  e.consistency = filter_.consistency();
+  e.consistency = monitor_.status();
   e.time_offset = filter_.timeOffset();
   e.time_offset_sigma = filter_.timeOffsetSigma();
   e.camr_drift_rate = filter_.camrDriftRate();

@@ -27,8 +27,7 @@ CalibrationFilter::CalibrationFilter(const FilterConfig& config, const StereoInt
     : config_(config),
       excitation_(config),
       coordinates_(config.inverse_depth_points != 0),
-      intrinsics_(intrinsics),
-      monitor_(config) {
+      intrinsics_(intrinsics) {
   const std::vector<std::string> problems = config.validate();
   if (!problems.empty()) {
     std::string message = "invalid filter configuration:";
@@ -128,7 +127,6 @@ void CalibrationFilter::startCalibration(const StereoExtrinsics& guess) {
   extrinsics_ = guess;
   previous_motions_.clear();
   excitation_.reset();
-  monitor_.reset();
   time_since_opened_ = {0.0, 0.0};
   ++starts_;
   points_.clear();
@@ -207,9 +205,6 @@ StepReport CalibrationFilter::step(const MotionIncrement& motion,
   previous_motions_.push_back(motion);
   if (static_cast<int>(previous_motions_.size()) > kTwistTrendIncrements)
     previous_motions_.erase(previous_motions_.begin());
-  if (report.jump != JumpBlock::kNone) monitor_.clearWindow();  // the evidence was the jump's
-  monitor_.addUpdate(motion.dt, has_scores_ ? &scores_ : nullptr);
-  report.consistency = monitor_.status();
   report.accepted = true;
   return report;
 }

@@ -46,6 +46,7 @@ bool CalibrationFilter::canReopen(JumpBlock block) const {
 }
 
 void CalibrationFilter::applyReopening(const Reopening& reopening, StepReport* report) {
+  ++reopenings_;
   report->jump = reopening.block;
   report->message = reopening.message;
   if (reopening.turned) {
@@ -68,7 +69,7 @@ std::vector<PointId> CalibrationFilter::reopen(JumpBlock block, const Vector6d& 
   points_.clear();
   index_.clear();
   last_prediction_.reset();
-  monitor_.clearWindow();
+  ++reopenings_;
   widenBlock(block, sigma);
   return removed;
 }

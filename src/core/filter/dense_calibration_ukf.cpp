@@ -14,7 +14,8 @@ namespace osc {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-DenseCalibrationUkf::DenseCalibrationUkf(const FilterConfig& config, const StereoIntrinsics& intrinsics)
+DenseCalibrationUkf::DenseCalibrationUkf(const FilterConfig& config,
+                                         const StereoIntrinsics& intrinsics)
     : config_(config), excitation_(config), intrinsics_(intrinsics) {
   ut_.alpha = config.ut_alpha;
   ut_.beta = config.ut_beta;
@@ -82,7 +83,8 @@ bool DenseCalibrationUkf::step(const MotionIncrement& motion,
     return true;
   };
   UnscentedResult predicted;
-  if (!unscentedTransform(VectorXd::Zero(n + noise_dim), Pa, predict, ut_, &predicted, false)) return false;
+  if (!unscentedTransform(VectorXd::Zero(n + noise_dim), Pa, predict, ut_, &predicted, false))
+    return false;
   MatrixXd P = predicted.covariance;
   P.topLeftCorner<12, 12>() += calibrationDriftCovariance(config_, motion.dt);
   const double scale = noiseScale(config_, motion.dt);
@@ -111,11 +113,13 @@ bool DenseCalibrationUkf::step(const MotionIncrement& motion,
   }
   const VectorFunction observe = [&](const VectorXd& x, VectorXd* y) {
     y->resize(4 * N);
-    const StereoExtrinsics e{base.T_veh_caml, boxPlus(base.T_caml_camr, x.segment<6>(layout::kCamr))};
+    const StereoExtrinsics e{base.T_veh_caml,
+                             boxPlus(base.T_caml_camr, x.segment<6>(layout::kCamr))};
     const Eigen::Isometry3d T_ropt_lopt = e.leftToRightOptical().inverse();
     for (int i = 0; i < N; ++i) {
       Eigen::Vector4d zi;
-      if (!projectStereo(predicted_means[i] + x.segment<3>(12 + 3 * i), T_ropt_lopt, intrinsics_, 1e-3, &zi)) {
+      if (!projectStereo(predicted_means[i] + x.segment<3>(12 + 3 * i), T_ropt_lopt, intrinsics_,
+                         1e-3, &zi)) {
         return false;
       }
       y->segment<4>(4 * i) = zi;

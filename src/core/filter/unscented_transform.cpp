@@ -85,11 +85,12 @@ bool unscentedTransform(const Eigen::VectorXd& mean, const Eigen::MatrixXd& cova
 
   // Statistical linearisation A = Cov(y,x) Cov(x)^-1 = Cov(y,x) S^-T S^-1.
   const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(L, L);
-  const Eigen::MatrixXd S_inv = result->repaired_input
-                                    ? Eigen::MatrixXd(S.inverse())
-                                    : Eigen::MatrixXd(S.triangularView<Eigen::Lower>().solve(identity));
+  const Eigen::MatrixXd S_inv =
+      result->repaired_input ? Eigen::MatrixXd(S.inverse())
+                             : Eigen::MatrixXd(S.triangularView<Eigen::Lower>().solve(identity));
   result->jacobian = result->cross * S_inv.transpose() * S_inv;
-  result->residual = result->covariance - result->jacobian * covariance * result->jacobian.transpose();
+  result->residual =
+      result->covariance - result->jacobian * covariance * result->jacobian.transpose();
   makeSymmetricPsd(&result->residual, 0.0);
   return result->mean.allFinite() && result->covariance.allFinite() && result->jacobian.allFinite();
 }

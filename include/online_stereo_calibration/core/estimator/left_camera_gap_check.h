@@ -43,18 +43,18 @@ class LeftCameraGapCheck {
   explicit LeftCameraGapCheck(const LeftCameraGapCheckOptions& options) : options_(options) {}
 
   /// Before a step with @p has_tracked tracked points: if they end an unobserved stretch, the
-  /// filter's consistency evidence is forgotten and the check armed.
-  void beforeStep(CalibrationFilter* filter, bool has_tracked);
+  /// consistency monitor's evidence is forgotten and the check armed.
+  void beforeStep(ConsistencyMonitor* monitor, bool has_tracked);
   /// After the step (accepted or not): a step that used a measurement ends the unobserved
   /// stretch, any other adds its dt.
   void countAfterStep(const MotionIncrement& motion, const StepReport& step);
   /// x_caml was re-opened on its own evidence (a jump): the check has its answer.
   void disarm() { check_left_ = 0.0; }
   /// After an accepted step without a jump, while armed: re-opens x_caml if the monitor's
-  /// x_caml statistic (StepReport::consistency) is beyond its bound after at least three
-  /// updates in its window.
+  /// x_caml statistic (@p consistency, after the step's update) is beyond its bound after at
+  /// least three updates in its window.
   GapDecision checkAfterStep(CalibrationFilter* filter, const MotionIncrement& motion,
-                             const StepReport& step);
+                             const StepReport& step, const ConsistencyStatus& consistency);
   /// Forgets the stretch and disarms (a reset).
   void reset() {
     unobserved_time_ = 0.0;

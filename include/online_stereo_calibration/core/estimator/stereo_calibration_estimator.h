@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "online_stereo_calibration/core/config/filter_config.h"
-#include "online_stereo_calibration/core/estimator/baseline_from_motion.h"
+#include "online_stereo_calibration/core/estimator/baseline_restart.h"
 #include "online_stereo_calibration/core/estimator/epipolar_consistency.h"
 #include "online_stereo_calibration/core/estimator/frame_event.h"
 #include "online_stereo_calibration/core/estimator/jump_test.h"
@@ -62,6 +62,9 @@ struct CalibrationEstimate {
 /// What happened to one image pair.
 struct FrameReport {
   StepReport step;  ///< the filter step (empty for the first pair)
+  /// The consistency monitor after the step (per-block window statistics, bounds, the
+  /// drift-noise factors it set; consistency_monitor.h).
+  ConsistencyStatus consistency;
   /// What the components did in this frame and what they found wrong, one line each, in
   /// order (frame_event.h): re-openings, restarts, widenings, a rejected motion, a baseline
   /// guess no point triangulates with, ...
@@ -97,9 +100,6 @@ class StereoCalibrationEstimator {
   /// re-opened to at least `rotation_sigma` (rad) and every point is forgotten. Its translation
   /// is kept (a knock turns a camera). Returns the forgotten points.
   std::vector<PointId> reopenRightCameraRotation(double rotation_sigma);
-  /// The current x_camr turned about its centre so that the disparity offset @p offset (rad,
-  /// BaselineLength::offset) vanishes (withoutDisparityOffset), in the body frames.
-  Eigen::Isometry3d rightCameraTurnedByDisparityOffset(double offset) const;
   /// x_camr re-seeded from a whole-image stereo fit (CalibrationPipeline at a start or after
   /// a re-opening, FilterConfig::stereo_fit_start): its mean becomes @p T_caml_camr and its tangent
   /// covariance block @p covariance (m, rad; [dt, dtheta] as the filter's), uncorrelated with
@@ -145,12 +145,10 @@ class StereoCalibrationEstimator {
   /// (FilterConfig::baseline_from_motion) from a front end that does not track the pairs the
   /// filter refused (CalibrationPipeline matches them by their left descriptors). Without
   /// them, the candidates seen with the same id in both pairs are linked.
-  void linkStereoMatches(std::vector<std::pair<StereoObservation, StereoObservation>> links) {
-    given_links_ = std::move(links);
-  }
+  void linkStereoMatches(const std::vector<std::pair<StereoObservation, StereoObservation>>& links);
   /// The baseline's length from motion wants linkStereoMatches for the next pair: no point
   /// could be initialised in the last one.
-  bool wantsStereoLinks() const { return !previous_candidates_.empty(); }
+  bool wantsStereoLinks() const { return baseline_restart_.wantsLinks(); }
   /// The hand-eye start is still collecting (on, rotation not yet determined).
   bool handEyeActive() const { return config_.hand_eye_start != 0 && !mounting_.done(); }
   /// The hand-eye start's pairs and solver (FilterConfig::hand_eye_start).
@@ -167,10 +165,10 @@ class StereoCalibrationEstimator {
   bool restartIfLinearizedFarOff(FrameReport* report);
   /// The gap check (left_camera_gap_check.h) after an accepted step without a jump: x_caml
   /// re-opened (every point dropped into report->dropped,
-  /// FrameReport::left_camera_reopened_after_gap, its warning) and anchored. True if it did.
+  /// FrameEvent::kLeftCameraReopenedAfterGap) and anchored. True if it did.
   bool reopenLeftCameraAfterGap(const MotionIncrement& motion, FrameReport* report);
   /// Counts the pairs whose @p tracked points were all measured and none predictable, and
-  /// warns (FrameReport::no_point_measurable) at the kUnmeasurablePairsToWarn-th in a row.
+  /// warns (FrameEvent::kNoPointMeasurable) at the kUnmeasurablePairsToWarn-th in a row.
   void warnIfNoPointMeasurable(const std::vector<PointMeasurement>& tracked, FrameReport* report);
   /// What a reset forgets besides the filter: the evidence on the baseline, the knock,
   /// few-points and unmeasurable streaks, the hand-eye pairs, the unobserved stretch.
@@ -182,14 +180,13 @@ class StereoCalibrationEstimator {
   bool restartFromMotion(const MotionIncrement& motion,
                          const std::vector<StereoObservation>& observations, FrameReport* report);
 
-  /// While no point can be initialised: links this pair's candidates to the previous pair's
-  /// and, once the baseline's length from motion is known well enough, restarts x_camr's
-  /// translation with it (FilterConfig::baseline_from_motion). True if it did.
-  /// @p motion_links_pairs: the motion is the one since the last pair processed (not the
-  /// first pair after a start or a reset).
-  bool learnBaselineLength(const MotionIncrement& motion, bool motion_links_pairs,
+  /// The consistency monitor follows the filter: a start since the last call resets it, a
+  /// re-opening empties its window. Called after every call that may start or re-open.
+  void followFilter();
+  /// While no point can be initialised: BaselineRestart's pair, and x_camr re-seeded at the
+  /// length from motion when it proposes it (FilterConfig::baseline_from_motion).
+  void learnBaselineLength(const MotionIncrement& motion, bool motion_links_pairs,
                            const std::vector<PointMeasurement>& candidates, FrameReport* report);
-  void forgetBaselineEvidence();
   /// Tests this pair's stereo pairs (tracked and new) against x_camr's epipolar lines
   /// (epipolar_consistency.h) and, after FilterConfig::epipolar_knock_pairs contradicting
   /// pairs in a row, re-opens x_camr's rotation (reopenRightCameraRotation): the tracked
@@ -205,13 +202,13 @@ class StereoCalibrationEstimator {
   /// The last pair had too few stereo pairs to update (FrameReport::too_few_points).
   bool held_for_few_points_ = false;
   /// Pairs in a row whose tracked points were all measured and none predictable
-  /// (FrameReport::no_point_measurable).
+  /// (FrameEvent::kNoPointMeasurable).
   int unmeasurable_pairs_ = 0;
   /// Linearisation guard: the restart from the estimate after a start or re-opening far off.
   RestartFromEstimate restart_;
-  /// Change detection, x_camr: its rotation widened on the evidence of the updates' score.
   /// Change detection at the filter's gate: many points gated out, a block jumped.
   JumpTest jump_test_;
+  /// Change detection, x_camr: its rotation widened on the evidence of the updates' score.
   RightCameraScoreTest score_test_;
   /// Change detection, x_caml: tested when points come back after a stretch without any.
   LeftCameraGapCheck gap_check_;
@@ -221,11 +218,13 @@ class StereoCalibrationEstimator {
   StereoExtrinsics guess_;
   Eigen::MatrixXd guess_covariance_;
   MountingFromMotion mounting_;
-  /// The baseline's length from motion (learnBaselineLength) and the last pair's candidates
-  /// (undistorted pixels) while no point could be initialised.
-  BaselineFromMotion baseline_from_motion_;
-  std::unordered_map<PointId, Eigen::Vector4d> previous_candidates_;
-  std::vector<std::pair<StereoObservation, StereoObservation>> given_links_;
+  /// Start: the baseline's length from motion while no point could be initialised.
+  BaselineRestart baseline_restart_;
+  /// Per-block score test of the updates; scales the filter's random walk (eq. 10-13) per
+  /// block. Its window ends with each start and re-opening of the filter (followFilter).
+  ConsistencyMonitor monitor_;
+  int monitor_starts_ = 0;      ///< CalibrationFilter::starts() the monitor has followed
+  int monitor_reopenings_ = 0;  ///< CalibrationFilter::reopenings() it has followed
 };
 
 }  // namespace osc

@@ -117,9 +117,6 @@ struct StepReport {
   /// >= 1: the factor the update's measurement covariances were multiplied by so that no
   /// calibration sigma shrank by more than max_sigma_shrink_per_update (update_tempering.h).
   double tempering = 1.0;
-  /// The consistency monitor after this step (per-block window statistics, bounds, the
-  /// drift-noise factors it set; consistency_monitor.h).
-  ConsistencyStatus consistency;
 };
 
 /// Structured UKF for the stereo extrinsics and the tracked points.
@@ -187,6 +184,12 @@ class CalibrationFilter {
   /// How many times the filter was started (reset, restartCalibration): a component that
   /// counts steps since a start compares it.
   int starts() const { return starts_; }
+  /// How many times a block was re-opened (reopen, or a change detector's verdict in a step):
+  /// a component whose evidence a re-opening ends (the consistency monitor) compares it.
+  int reopenings() const { return reopenings_; }
+  /// The factors on x_caml's and x_camr's random walk (eq. 10-13) from the next prediction
+  /// on (the consistency monitor's; 1 = as configured).
+  void setDriftInflation(const std::array<double, 2>& factors) { drift_inflation_ = factors; }
   /// How much of the recent vehicle rotation is excitation, per axis (MotionExcitation).
   Eigen::Vector3d excitationGains() const { return excitation_.gains(); }
 
@@ -216,11 +219,6 @@ class CalibrationFilter {
   /// coordinates (FilterConfig::inverse_depth_points, in units of the baseline with
   /// FilterConfig::baseline_scaled_points). For tests and diagnostics; O(N^2).
   Eigen::MatrixXd denseCovariance() const;
-
-  /// The consistency monitor's state: per-block statistics and the drift-noise factors.
-  const ConsistencyStatus& consistency() const { return monitor_.status(); }
-  /// Empties the consistency monitor's window (ConsistencyMonitor::forgetEvidence).
-  void forgetConsistencyEvidence() { monitor_.forgetEvidence(); }
 
   const FilterConfig& config() const { return config_; }
   const StereoIntrinsics& intrinsics() const { return intrinsics_; }
@@ -318,8 +316,11 @@ class CalibrationFilter {
   /// s of accepted motion since each block (x_caml, x_camr) was started or widened
   /// (canReopen).
   std::array<double, 2> time_since_opened_ = {0.0, 0.0};
-  /// Starts so far (startCalibration).
+  /// Starts so far (startCalibration) and re-openings (reopen, applyReopening).
   int starts_ = 0;
+  int reopenings_ = 0;
+  /// Factors on x_caml's and x_camr's random walk (setDriftInflation).
+  std::array<double, 2> drift_inflation_ = {1.0, 1.0};
   PointCoordinates coordinates_;  ///< how TrackedPoint::mean stores a point
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;
@@ -333,8 +334,6 @@ class CalibrationFilter {
   /// from the same state, reuses it instead of repeating the per-point UTs (so neither
   /// predictObservations nor step may run concurrently on one filter).
   mutable std::shared_ptr<const Prediction> last_prediction_;
-  /// Per-block score test of the updates; scales the random walk of eq. 10-13 per block.
-  ConsistencyMonitor monitor_;
   /// The final pass's scores of this step, for the monitor (has_scores_: an update ran).
   UpdateScores scores_;
   bool has_scores_ = false;
