@@ -8,40 +8,34 @@
 ///            [--right-info T] [--odom T]
 ///
 /// Reads NS/{left,right}/image_raw and camera_info (NS = /stereo) and /odom (poses interpolated
-/// to the image stamps, linear + SLERP), pairs the images by exact stamp and writes
-/// DIR/estimates.csv
-/// and DIR/calibration.yaml (the final estimate). With a reference also DIR/reference.csv,
-/// DIR/table.txt (Table I, consistency, convergence after a step, time per frame; also on
-/// stdout) and the plots of scripts/plot_convergence.py. Without --initial-guess the file
-/// initial_guess.yaml next to the bag is used (as `simulate` writes it).
-#include <sys/stat.h>
+/// to the image stamps, linear + SLERP), pairs the images by exact stamp and runs the loop of
+/// tools/drive_evaluation.h: DIR/estimates.csv and DIR/calibration.yaml (the final estimate);
+/// with a reference also DIR/reference.csv, DIR/table.txt (Table I, consistency, convergence
+/// after a step, time per frame; also on stdout) and the plots of scripts/plot_convergence.py.
+/// Without --initial-guess the file initial_guess.yaml next to the bag is used (as `simulate`
+/// writes it).
 #include <unistd.h>
 #include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <cstdlib>
-#include <fstream>
+#include <cstdint>
 #include <iostream>
 #include <map>
-#include <sstream>
+#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <cv_bridge/cv_bridge.h>
 #include <sensor_msgs/Image.h>
 #include <opencv2/core/utility.hpp>
 
 #include "bag_io.h"
-#include "online_stereo_calibration/core/pipeline/calibration_pipeline.h"
-#include "online_stereo_calibration/tools/bag_evaluation.h"
 #include "online_stereo_calibration/tools/calibration_file.h"
 #include "online_stereo_calibration/tools/command_line.h"
-#include "online_stereo_calibration/tools/estimates_csv.h"
+#include "online_stereo_calibration/tools/drive_evaluation.h"
 #include "online_stereo_calibration/tools/estimator_config_yaml.h"
-#include "online_stereo_calibration/tools/evaluation.h"
 #include "online_stereo_calibration/tools/output_directory.h"
-#include "online_stereo_calibration/tools/package_files.h"
 
 namespace {
 
@@ -117,16 +111,6 @@ void finishOptions(Options* o) {
   fill(&o->right_info, "right/camera_info");
 }
 
-cv::Mat toMat(const sensor_msgs::ImageConstPtr& msg, cv_bridge::CvImageConstPtr* holder) {
-  const std::string& e = msg->encoding;
-  if (e == "mono8" || e == "mono16" || e == "bgr8" || e == "bgra8") {
-    *holder = cv_bridge::toCvShare(msg);
-  } else {
-    *holder = cv_bridge::toCvShare(msg, "bgr8");
-  }
-  return (*holder)->image;
-}
-
 /// First CameraInfo on a topic.
 osc::CameraIntrinsics readCameraInfo(const rosbag::Bag& bag, const std::string& topic) {
   rosbag::View view(bag, rosbag::TopicQuery(topic));
@@ -137,17 +121,142 @@ osc::CameraIntrinsics readCameraInfo(const rosbag::Bag& bag, const std::string& 
   throw std::runtime_error("no sensor_msgs/CameraInfo on " + topic);
 }
 
-std::string quote(const std::string& s) { return "'" + s + "'"; }
+/// A bag as the evaluation's input: image pairs by exact stamp, odometry poses interpolated
+/// (and their twists), the reference from a file or a truth topic.
+class BagSource : public osc::DriveSource {
+ public:
+  explicit BagSource(const Options& options) : path_(options.bag) {
+    topics_.left_image = options.left_image;
+    topics_.right_image = options.right_image;
+    topics_.left_info = options.left_info;
+    topics_.right_info = options.right_info;
+    topics_.odom = options.odom;
+    bag_.open(options.bag, rosbag::bagmode::Read);
+    std::vector<osc::bag::RequiredTopic> required = {
+        {"--left-image", topics_.left_image, "sensor_msgs/Image"},
+        {"--right-image", topics_.right_image, "sensor_msgs/Image"},
+        {"--left-info", topics_.left_info, "sensor_msgs/CameraInfo"},
+        {"--right-info", topics_.right_info, "sensor_msgs/CameraInfo"},
+        {"--odom", topics_.odom, "nav_msgs/Odometry"}};
+    if (!options.truth_topic.empty()) {
+      required.push_back(
+          {"--truth-topic", options.truth_topic, "online_stereo_calibration/StereoCalibration"});
+    }
+    osc::bag::requireTopics(bag_, options.bag, required);
+    osc::makeDirectories(options.out);
+    left_camera_ = readCameraInfo(bag_, topics_.left_info);
+    right_camera_ = readCameraInfo(bag_, topics_.right_info);
+    // One pass over the bag for both (see readOdometryAndCalibration).
+    inputs_ = osc::bag::readOdometryAndCalibration(bag_, topics_.odom, options.truth_topic);
+    for (const auto& [stamp, parameters] : inputs_.calibration) truth_[stamp] = parameters;
+    if (inputs_.odometry.size() < 2)
+      throw std::runtime_error("fewer than 2 odometry poses on " + topics_.odom);
+    if (!options.truth_topic.empty() && truth_.empty()) {
+      throw std::runtime_error("no StereoCalibration on " + options.truth_topic);
+    }
+    if (!options.reference.empty()) {
+      constant_reference_ = osc::readCalibrationFile(options.reference).extrinsics.toParameters();
+    }
+    pair_count_ =
+        static_cast<int>(rosbag::View(bag_, rosbag::TopicQuery(topics_.left_image)).size());
+    images_ = std::make_unique<rosbag::View>(
+        bag_, rosbag::TopicQuery({topics_.left_image, topics_.right_image}));
+    next_ = images_->begin();
+  }
+
+  /// What the bag holds, on @p log (the run's first lines).
+  void describe(std::ostream& log, const std::string& detector) const {
+    log << "evaluating " << path_ << ": " << pair_count_ << " left images on " << topics_.left_image
+        << ", " << inputs_.odometry.size() << " odometry poses on " << topics_.odom << ", "
+        << left_camera_.width << "x" << left_camera_.height << ", " << detector << " front end\n";
+    if (inputs_.samples_without_twist > 0) {
+      log << "evaluate: " << inputs_.samples_without_twist << " of " << inputs_.odometry.size()
+          << " odometry messages without a usable twist (" << inputs_.twist_problem
+          << "): the time offset uses the trend of earlier increments there\n";
+    }
+  }
+
+  std::string name() const override { return "Bag " + path_; }
+  osc::CameraIntrinsics leftCamera() const override { return left_camera_; }
+  osc::CameraIntrinsics rightCamera() const override { return right_camera_; }
+  int pairCount() const override { return pair_count_; }
+
+  bool next(osc::StereoPairInput* pair) override {
+    for (; next_ != images_->end(); ++next_) {
+      const auto image = next_->instantiate<sensor_msgs::Image>();
+      if (!image) continue;
+      const std::int64_t key = static_cast<std::int64_t>(image->header.stamp.toNSec());
+      const bool is_left = next_->getTopic() == topics_.left_image;
+      auto& mine = is_left ? pending_left_ : pending_right_;
+      auto& other = is_left ? pending_right_ : pending_left_;
+      const auto match = other.find(key);
+      if (match == other.end()) {
+        mine[key] = image;
+        continue;
+      }
+      const sensor_msgs::ImageConstPtr left = is_left ? image : match->second;
+      const sensor_msgs::ImageConstPtr right = is_left ? match->second : image;
+      other.erase(other.begin(), std::next(match));  // older unmatched images never pair now
+      mine.erase(mine.begin(), mine.lower_bound(key));
+      ++next_;
+      auto holders =
+          std::make_shared<std::pair<cv_bridge::CvImageConstPtr, cv_bridge::CvImageConstPtr>>();
+      pair->stamp = left->header.stamp.toSec();
+      pair->stamp_ns = key;
+      pair->left = toMat(left, &holders->first);
+      pair->right = toMat(right, &holders->second);
+      pair->owner = holders;
+      return true;
+    }
+    return false;
+  }
+
+  std::optional<osc::MotionIncrement> motionBetween(double from, double to) const override {
+    auto increment = inputs_.odometry.motionBetween(from, to, kOdomTolerance);
+    if (increment) {
+      // The odometry's own twists at both stamps for the time offset, as the node does.
+      increment->has_twists = inputs_.odometry_twists.twistAt(from, &increment->twist_start) &&
+                              inputs_.odometry_twists.twistAt(to, &increment->twist_end);
+    }
+    return increment;
+  }
+
+  bool hasReference() const override { return constant_reference_ || !truth_.empty(); }
+
+  std::optional<osc::Vector12d> referenceAt(std::int64_t stamp_ns) const override {
+    if (truth_.empty()) return constant_reference_;
+    const auto t = truth_.find(stamp_ns);
+    if (t == truth_.end()) return std::nullopt;
+    return t->second;
+  }
+
+ private:
+  static cv::Mat toMat(const sensor_msgs::ImageConstPtr& msg, cv_bridge::CvImageConstPtr* holder) {
+    const std::string& e = msg->encoding;
+    if (e == "mono8" || e == "mono16" || e == "bgr8" || e == "bgra8") {
+      *holder = cv_bridge::toCvShare(msg);
+    } else {
+      *holder = cv_bridge::toCvShare(msg, "bgr8");
+    }
+    return (*holder)->image;
+  }
+
+  std::string path_;
+  osc::bag::DriveTopics topics_;
+  rosbag::Bag bag_;
+  osc::CameraIntrinsics left_camera_, right_camera_;
+  osc::bag::OdometryAndCalibration inputs_;
+  std::map<std::int64_t, osc::Vector12d> truth_;  // the latest message of a stamp wins
+  std::optional<osc::Vector12d> constant_reference_;
+  int pair_count_ = 0;
+  std::unique_ptr<rosbag::View> images_;
+  rosbag::View::iterator next_;
+  std::map<std::int64_t, sensor_msgs::ImageConstPtr> pending_left_, pending_right_;
+};
 
 /// The tool itself, after the command line.
-int evaluateBag(const Options& options) {
+int evaluate(const Options& options) {
   cv::setNumThreads(options.threads);
-  osc::bag::DriveTopics topics;
-  topics.left_image = options.left_image;
-  topics.right_image = options.right_image;
-  topics.left_info = options.left_info;
-  topics.right_info = options.right_info;
-  topics.odom = options.odom;
   std::string guess_path = options.initial_guess;
   if (guess_path.empty()) guess_path = osc::directoryOf(options.bag) + "/initial_guess.yaml";
   if (!osc::isRegularFile(guess_path)) {
@@ -158,233 +267,15 @@ int evaluateBag(const Options& options) {
                                           ? osc::EstimatorConfig()
                                           : osc::readEstimatorConfigFile(options.config);
 
-  rosbag::Bag bag(options.bag, rosbag::bagmode::Read);
-  std::vector<osc::bag::RequiredTopic> required = {
-      {"--left-image", topics.left_image, "sensor_msgs/Image"},
-      {"--right-image", topics.right_image, "sensor_msgs/Image"},
-      {"--left-info", topics.left_info, "sensor_msgs/CameraInfo"},
-      {"--right-info", topics.right_info, "sensor_msgs/CameraInfo"},
-      {"--odom", topics.odom, "nav_msgs/Odometry"}};
-  if (!options.truth_topic.empty()) {
-    required.push_back(
-        {"--truth-topic", options.truth_topic, "online_stereo_calibration/StereoCalibration"});
-  }
-  osc::bag::requireTopics(bag, options.bag, required);
-  osc::makeDirectories(options.out);
-  const osc::CameraIntrinsics left_camera = readCameraInfo(bag, topics.left_info);
-  const osc::CameraIntrinsics right_camera = readCameraInfo(bag, topics.right_info);
-  // One pass over the bag for both (see readOdometryAndCalibration).
-  osc::bag::OdometryAndCalibration inputs =
-      osc::bag::readOdometryAndCalibration(bag, topics.odom, options.truth_topic);
-  const osc::PoseTrajectory odometry = std::move(inputs.odometry);
-  const online_stereo_calibration::PoseBuffer& odometry_twists = inputs.odometry_twists;
-  std::map<std::int64_t, osc::Vector12d> truth;  // the latest message of a stamp wins
-  for (const auto& [stamp, parameters] : inputs.calibration) truth[stamp] = parameters;
-  if (odometry.size() < 2)
-    throw std::runtime_error("fewer than 2 odometry poses on " + topics.odom);
-  if (!options.truth_topic.empty() && truth.empty()) {
-    throw std::runtime_error("no StereoCalibration on " + options.truth_topic);
-  }
-  const bool have_reference = !options.reference.empty() || !truth.empty();
-  osc::Vector12d constant_reference = osc::Vector12d::Zero();
-  if (!options.reference.empty()) {
-    constant_reference = osc::readCalibrationFile(options.reference).extrinsics.toParameters();
-  }
-
-  osc::CalibrationPipeline pipeline(config.filter, config.front_end, left_camera, right_camera,
-                                    guess.extrinsics);
-  int total = static_cast<int>(rosbag::View(bag, rosbag::TopicQuery(topics.left_image)).size());
-  if (options.max_pairs > 0) total = std::min(total, options.max_pairs);
-  std::cerr << "evaluating " << options.bag << ": " << total << " left images on "
-            << topics.left_image << ", " << odometry.size() << " odometry poses on " << topics.odom
-            << ", " << left_camera.width << "x" << left_camera.height << ", "
-            << config.front_end.detector << " front end\n";
-  if (inputs.samples_without_twist > 0) {
-    std::cerr << "evaluate: " << inputs.samples_without_twist << " of " << odometry.size()
-              << " odometry messages without a usable twist (" << inputs.twist_problem
-              << "): the time offset uses the trend of earlier increments there\n";
-  }
-
-  osc::EstimatesCsvWriter estimates_csv(options.out + "/estimates.csv");
-  std::vector<osc::EstimateRow> estimates;
-  std::vector<osc::ReferenceRow> reference;
-  std::vector<double> times;
-  std::map<std::int64_t, sensor_msgs::ImageConstPtr> pending_left, pending_right;
-  int frame = 0, skipped = 0;
-  double previous_stamp = 0.0;
-  bool have_previous = false;
-  const auto start = std::chrono::steady_clock::now();
-  auto last_report = start;
-  // A terminal gets a progress bar redrawn twice a second; a log file a line every 10 s.
-  const bool terminal = isatty(STDERR_FILENO) != 0;
-  const auto report_every =
-      terminal ? std::chrono::milliseconds(500) : std::chrono::milliseconds(10000);
-  rosbag::View images(bag, rosbag::TopicQuery({topics.left_image, topics.right_image}));
-  for (const rosbag::MessageInstance& m : images) {
-    if (options.max_pairs > 0 && frame >= options.max_pairs) break;
-    const auto image = m.instantiate<sensor_msgs::Image>();
-    if (!image) continue;
-    const std::int64_t key = static_cast<std::int64_t>(image->header.stamp.toNSec());
-    const bool is_left = m.getTopic() == topics.left_image;
-    auto& mine = is_left ? pending_left : pending_right;
-    auto& other = is_left ? pending_right : pending_left;
-    const auto match = other.find(key);
-    if (match == other.end()) {
-      mine[key] = image;
-      continue;
-    }
-    const sensor_msgs::ImageConstPtr left = is_left ? image : match->second;
-    const sensor_msgs::ImageConstPtr right = is_left ? match->second : image;
-    other.erase(other.begin(), std::next(match));  // older unmatched images never pair now
-    mine.erase(mine.begin(), mine.lower_bound(key));
-
-    const double stamp = left->header.stamp.toSec();
-    osc::MotionIncrement motion;
-    if (have_previous) {
-      // Read where the estimator believes the images were (its time offset), as the node.
-      const double shift = pipeline.estimator().odometryTimeShift();
-      const auto increment =
-          odometry.motionBetween(previous_stamp - shift, stamp - shift, kOdomTolerance);
-      if (increment) {
-        motion = *increment;
-        motion.time_shift = shift;
-        // The odometry's own twists at both stamps for the time offset, as the node does.
-        motion.has_twists = odometry_twists.twistAt(previous_stamp - shift, &motion.twist_start) &&
-                            odometry_twists.twistAt(stamp - shift, &motion.twist_end);
-      } else {
-        std::cerr << "\nevaluate: no odometry around pair " << frame << " (stamp " << stamp
-                  << "); tracking restarts\n";
-        pipeline.resetTracking();
-      }
-    }
-    cv_bridge::CvImageConstPtr left_holder, right_holder;
-    const osc::PipelineResult result =
-        pipeline.process(toMat(left, &left_holder), toMat(right, &right_holder), motion);
-    if (!result.processed) {
-      std::cerr << "\nevaluate: pair " << frame << " not used: " << result.status << "\n";
-      ++skipped;
-      ++frame;
-      continue;
-    }
-    previous_stamp = stamp;
-    have_previous = true;
-    // What the estimator did at a start far off (issue 14), in the progress output.
-    for (const std::string& warning : result.estimator.warnings) {
-      if ((result.estimator.right_rotation_from_stereo_fit &&
-           warning.rfind("right camera rotation from the stereo fit", 0) == 0) ||
-          (result.estimator.mounting_rotation_from_motion &&
-           warning.rfind("mounting rotation from motion", 0) == 0)) {
-        std::cerr << "\nevaluate: pair " << frame << ": " << warning << "\n";
-      }
-    }
-    osc::EstimateRow row;
-    row.frame = frame;
-    row.stamp = stamp;
-    row.parameters = result.estimate.parameters;
-    row.sigmas = result.estimate.sigmas();
-    row.tracked_points = static_cast<int>(result.estimate.tracked_points);
-    row.time_ms = 1000.0 * result.processing_time;
-    row.time_offset = result.estimate.time_offset;
-    row.time_offset_sigma = result.estimate.time_offset_sigma;
-    estimates_csv.write(row);
-    estimates.push_back(row);
-    times.push_back(row.time_ms);
-    if (have_reference) {
-      osc::ReferenceRow ref;
-      ref.frame = frame;
-      ref.stamp = stamp;
-      ref.parameters = constant_reference;
-      const auto t = truth.find(key);
-      if (truth.empty() || t != truth.end()) {
-        if (t != truth.end()) ref.parameters = t->second;
-        reference.push_back(ref);
-      }
-    }
-    ++frame;
-    const auto now = std::chrono::steady_clock::now();
-    if (frame == total || now - last_report > report_every) {
-      last_report = now;
-      std::cerr << (terminal ? "\r  " : "  ")
-                << osc::progressLine(frame, total,
-                                     std::chrono::duration<double>(now - start).count())
-                << "  points " << row.tracked_points << (terminal ? "" : "\n") << std::flush;
-    }
-  }
-  if (terminal) std::cerr << "\n";
-  estimates_csv.flush();
-  if (estimates.empty()) throw std::runtime_error("no stereo pair was processed");
-  const double elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  osc::writeCalibrationFileAtomic(options.out + "/calibration.yaml",
-                                  osc::calibrationFileOf(estimates.back()));
-
-  const osc::Percentiles timing = osc::percentiles(times);
-  std::ostringstream text;
-  int step_frame = -1;
-  if (!reference.empty()) {
-    osc::ReferenceCsvWriter reference_csv(options.out + "/reference.csv");
-    for (const osc::ReferenceRow& r : reference) reference_csv.write(r);
-    reference_csv.flush();
-    const int last_frame = estimates.back().frame;
-    int last = options.window_last >= 0 ? options.window_last : std::min(1150, last_frame);
-    int first =
-        options.window_first >= 0 ? options.window_first : std::min(1000, std::max(0, last - 150));
-    const osc::EvaluationReport report = osc::evaluateWindow(estimates, reference, first, last);
-    text << "Bag " << options.bag << ", RMSE over frames " << first << "-" << last << " ("
-         << report.frames_used << " frames used):\n"
-         << osc::formatTableI(report) << "\n";
-    double within = 0;
-    for (const auto& p : report.parameters) within += p.within_2sigma / 12.0;
-    text << "Consistency: " << 100.0 * within << " % of errors within 2 sigma (95.4 % if "
-         << "consistent), mean NEES " << report.mean_nees << " (1 if consistent)\n";
-    step_frame = osc::detectStepFrame(reference);
-    if (step_frame >= 0) {
-      int stepped = 0;
-      double largest = 0;
-      const auto& before =
-          std::find_if(reference.begin(), reference.end(),
-                       [&](const osc::ReferenceRow& r) { return r.frame == step_frame; });
-      for (int p = 0; p < 12 && before != reference.begin(); ++p) {
-        const double d = std::abs((before->parameters(p) - (before - 1)->parameters(p)) *
-                                  (osc::isAngleParameter(p) ? 1.0 : 0.1));
-        if (d > largest) largest = d, stepped = p;
-      }
-      const double tolerance = osc::isAngleParameter(stepped) ? 0.3 * M_PI / 180.0 : 0.03;
-      const int back = osc::framesToConverge(estimates, reference, stepped, tolerance, step_frame);
-      text << "Step at frame " << step_frame << " (largest in "
-           << osc::estimatesCsvColumns()[2 + stepped] << "): within "
-           << (osc::isAngleParameter(stepped) ? "0.3 deg" : "3 cm") << " from frame " << back
-           << " on (" << (back >= 0 ? back - step_frame : -1) << " frames to converge)\n";
-    }
-  } else {
-    const osc::EstimateRow& last = estimates.back();
-    text << "Bag " << options.bag << " (no reference): final estimate and 1 sigma\n";
-    for (int p = 0; p < 12; ++p) {
-      text << "  " << osc::estimatesCsvColumns()[2 + p] << " = " << last.parameters(p) << " +- "
-           << last.sigmas(p) << "\n";
-    }
-  }
-  text << "Pairs processed: " << estimates.size() << ", not used: " << skipped
-       << "; time per frame: median " << timing.median << " ms, p95 " << timing.p95 << " ms; total "
-       << elapsed << " s (" << estimates.size() / elapsed << " frames/s)\n";
-  std::cout << text.str();
-  std::ofstream(options.out + "/table.txt") << text.str();
-
-  const std::string script = osc::findPackageFile("scripts/plot_convergence.py", "OSC_PLOT_SCRIPT");
-  if (script.empty()) {
-    std::cerr << "evaluate: warning: scripts/plot_convergence.py not found (set "
-                 "OSC_PLOT_SCRIPT); no plots\n";
-  } else {
-    std::string command = "/usr/bin/python3 " + quote(script) + " --out " + quote(options.out);
-    if (step_frame >= 0) command += " --step-frame " + std::to_string(step_frame);
-    if (std::system(command.c_str()) != 0) {
-      std::cerr << "evaluate: warning: the plots failed (" << command << ")\n";
-    }
-  }
-  std::cout << "wrote " << options.out << "/estimates.csv, calibration.yaml, table.txt"
-            << (reference.empty() ? "" : ", reference.csv") << "\n";
-  return 0;
+  osc::DriveEvaluationOptions run;
+  run.out = options.out;
+  run.window_first = options.window_first;
+  run.window_last = options.window_last;
+  run.max_pairs = options.max_pairs;
+  run.progress_bar = isatty(STDERR_FILENO) != 0;
+  BagSource source(options);
+  source.describe(std::cerr, config.front_end.detector);
+  return osc::evaluateDrive(source, config, guess.extrinsics, run, std::cout, std::cerr);
 }
 
 }  // namespace
@@ -397,6 +288,6 @@ int main(int argc, char** argv) {
       [&] {
         if (!cli.parse(argc, argv)) return 0;
         finishOptions(&parsed);
-        return evaluateBag(parsed);
+        return evaluate(parsed);
       });
 }
