@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -18,7 +19,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "online_stereo_calibration/core/geometry/rotation.h"
+#include "online_stereo_calibration/tools/estimates_csv.h"
 #include "online_stereo_calibration/tools/kitti_raw_drive.h"
+#include "online_stereo_calibration/tools/kitti_raw_source.h"
 #include "temp_dir.h"
 
 namespace osc {
@@ -395,6 +398,46 @@ TEST(KittiRawDrive, RectifiedImagesAndTheSyncedLayoutAreRecognised) {
   const Eigen::Matrix3d R_raw = poseFromParameters(raw.head<6>()).linear();
   const Eigen::Matrix3d R_rect = poseFromParameters(truth.head<6>()).linear();
   EXPECT_NEAR(rotationDistance(R_raw, R_rect), 0.749 * kDeg, 0.001 * kDeg);
+}
+
+// evaluate's loop (drive_evaluation.h) on the drive's first six usable frames: the pairs in
+// order with their stamps, KITTI's chain as every pair's reference, the skipped frames in
+// table.txt.
+TEST(KittiRawDrive, EvaluationRunsOnTheFirstFramesAgainstKittisChain) {
+  SKIP_WITHOUT_DRIVE();
+  TempDir dir("kitti_raw_eval");
+  KittiRawSource source(sharedDrive());
+  EXPECT_EQ(source.name(), "KITTI raw drive " + kDrive);
+  EXPECT_EQ(source.pairCount(), 196);
+  DriveEvaluationOptions options;
+  options.out = dir.file("eval");
+  options.max_pairs = 6;
+  options.notes = {"skipped: " + sharedDrive().skippedLines()[2]};
+  Vector12d guess = sharedDrive().truth();
+  guess(0) += 0.5;
+  guess(7) += 0.1;
+  std::ostringstream out, log;
+  ASSERT_EQ(evaluateDrive(source, EstimatorConfig(), StereoExtrinsics::fromParameters(guess),
+                          options, out, log),
+            0);
+  const std::vector<EstimateRow> estimates = readEstimatesCsv(dir.file("eval/estimates.csv"));
+  const std::vector<ReferenceRow> reference = readReferenceCsv(dir.file("eval/reference.csv"));
+  ASSERT_EQ(estimates.size(), 6u) << log.str();
+  ASSERT_EQ(reference.size(), 6u);
+  for (std::size_t k = 0; k < 6; ++k) {
+    EXPECT_EQ(estimates[k].frame, static_cast<int>(k));
+    EXPECT_NEAR(estimates[k].stamp, sharedDrive().frames[k].stamp(), 1e-6);
+    EXPECT_TRUE(reference[k].parameters.isApprox(sharedDrive().truth(), 1e-12));
+    EXPECT_GT(estimates[k].tracked_points, 0) << k;
+  }
+  // The first pair has no motion: xl is still at the guess.
+  EXPECT_NEAR(estimates[0].parameters(0), guess(0), 0.3);
+  const std::string table = out.str();
+  EXPECT_NE(table.find("KITTI raw drive " + kDrive + ", RMSE over frames 0-5"), std::string::npos)
+      << table;
+  EXPECT_NE(table.find("skipped: frame 22: no right image"), std::string::npos) << table;
+  EXPECT_EQ(log.str().find("no odometry around pair"), std::string::npos) << log.str();
+  EXPECT_TRUE(fs::exists(dir.file("eval/calibration.yaml")));
 }
 
 TEST(KittiRawDrive, TimestampsParseToNanosecondsSince1970) {

@@ -1,19 +1,23 @@
 /// @file evaluate_main.cpp
-/// @brief Runs the calibration pipeline over a bag as fast as possible, without a ROS master
-/// (interface.md, "Offline evaluation"):
+/// @brief Runs the calibration pipeline over a bag or a KITTI raw drive folder as fast as
+/// possible, without a ROS master (interface.md, "Offline evaluation"):
 ///
 ///   evaluate --bag DRIVE.bag --out DIR [--initial-guess GUESS.yaml] [--config PARAMS.yaml]
 ///            [--reference REF.yaml | --truth-topic TOPIC] [--window FIRST LAST]
 ///            [--stereo-ns NS] [--left-image T] [--right-image T] [--left-info T]
 ///            [--right-info T] [--odom T]
+///   evaluate --kitti-raw DIR --out OUT [--initial-guess GUESS.yaml] [--config PARAMS.yaml]
+///            [--window FIRST LAST] [--oxts-position velocity|gps] [--oxts-max-gap S]
 ///
-/// Reads NS/{left,right}/image_raw and camera_info (NS = /stereo) and /odom (poses interpolated
-/// to the image stamps, linear + SLERP), pairs the images by exact stamp and runs the loop of
-/// tools/drive_evaluation.h: DIR/estimates.csv and DIR/calibration.yaml (the final estimate);
-/// with a reference also DIR/reference.csv, DIR/table.txt (Table I, consistency, convergence
-/// after a step, time per frame; also on stdout) and the plots of scripts/plot_convergence.py.
-/// Without --initial-guess the file initial_guess.yaml next to the bag is used (as `simulate`
-/// writes it).
+/// A bag: reads NS/{left,right}/image_raw and camera_info (NS = /stereo) and /odom (poses
+/// interpolated to the image stamps, linear + SLERP), pairs the images by exact stamp. A KITTI
+/// raw folder (tools/kitti_raw_drive.h): image_00/01, the OXTS motion, KITTI's calibration
+/// chain as the reference; the frames it skips are listed. Both then run the same loop
+/// (tools/drive_evaluation.h): DIR/estimates.csv and DIR/calibration.yaml (the final
+/// estimate); with a reference also DIR/reference.csv, DIR/table.txt (Table I, consistency,
+/// convergence after a step, time per frame; also on stdout) and the plots of
+/// scripts/plot_convergence.py. Without --initial-guess the file initial_guess.yaml next to
+/// the bag (as `simulate` writes it), or in the KITTI folder, is used.
 #include <unistd.h>
 #include <algorithm>
 #include <cstdint>
@@ -35,39 +39,54 @@
 #include "online_stereo_calibration/tools/command_line.h"
 #include "online_stereo_calibration/tools/drive_evaluation.h"
 #include "online_stereo_calibration/tools/estimator_config_yaml.h"
+#include "online_stereo_calibration/tools/kitti_raw_source.h"
 #include "online_stereo_calibration/tools/output_directory.h"
 
 namespace {
 
 struct Options {
-  std::string bag, out, initial_guess, config, reference, truth_topic;
+  std::string bag, kitti_raw, out, initial_guess, config, reference, truth_topic;
   int window_first = -1, window_last = -1;
   int max_pairs = -1;  ///< stop after this many stereo pairs (-1: all)
   int threads = 1;     ///< OpenCV's worker threads (cv::setNumThreads)
   /// Topics (interface.md: left/image_raw, ... relative to the stereo namespace, and odom).
   std::string stereo_ns = "/stereo";
   std::string left_image, right_image, left_info, right_info, odom = "/odom";
+  /// KITTI raw: where the positions come from, and the longest OXTS gap bridged (s).
+  std::string oxts_position = "velocity";
+  double oxts_max_gap = osc::KittiRawOptions().max_oxts_gap;
 };
 
 /// Odometry further than this (s) beyond an image stamp is not extrapolated.
 constexpr double kOdomTolerance = 0.02;
 
+/// The options that only a bag or only a KITTI folder takes.
+const std::vector<std::string> kBagOnlyOptions = {"--reference",  "--truth-topic", "--stereo-ns",
+                                                  "--left-image", "--right-image", "--left-info",
+                                                  "--right-info", "--odom"};
+const std::vector<std::string> kKittiOnlyOptions = {"--oxts-position", "--oxts-max-gap"};
+
 /// The command line (`--help` prints it).
 osc::CommandLine commandLine(Options* o) {
   osc::CommandLine cli(
       "evaluate",
-      "Runs the calibration pipeline (front end + filter, as the nodelet) over a bag as fast as "
-      "possible,\nwithout a ROS master; writes DIR/estimates.csv and calibration.yaml, and with "
-      "a reference\nreference.csv, table.txt (Table I) and convergence plots.");
-  cli.option("--bag", &o->bag, "DRIVE.bag", "input bag").required();
+      "Runs the calibration pipeline (front end + filter, as the nodelet) over a bag or a KITTI "
+      "raw drive\nfolder as fast as possible, without a ROS master; writes DIR/estimates.csv and "
+      "calibration.yaml,\nand with a reference reference.csv, table.txt (Table I) and "
+      "convergence plots.");
+  cli.option("--bag", &o->bag, "DRIVE.bag", "input bag (or --kitti-raw)");
+  cli.option("--kitti-raw", &o->kitti_raw, "DIR",
+             "input KITTI raw drive folder (image_00/01, oxts, calib_*.txt; or --bag): KITTI's "
+             "calibration is the reference");
   cli.option("--out", &o->out, "DIR", "output directory").required();
   cli.option("--initial-guess", &o->initial_guess, "GUESS.yaml",
-             "initial calibration (default: initial_guess.yaml beside the bag)");
+             "initial calibration (default: initial_guess.yaml beside the bag or in the KITTI "
+             "folder)");
   cli.option("--config", &o->config, "PARAMS.yaml",
              "estimator parameters: filter keys (config/default.yaml) and a front_end: map");
-  cli.option("--reference", &o->reference, "REF.yaml", "fixed true calibration");
+  cli.option("--reference", &o->reference, "REF.yaml", "fixed true calibration (--bag)");
   cli.option("--truth-topic", &o->truth_topic, "TOPIC",
-             "per-frame truth (StereoCalibration), e.g. /ground_truth/calibration");
+             "per-frame truth (StereoCalibration), e.g. /ground_truth/calibration (--bag)");
   cli.option("--window", &o->window_first, &o->window_last, "FIRST LAST",
              "frames of the Table I RMSE (default 1000 1150, clipped to the drive)")
       .range(0, 1e9)
@@ -82,6 +101,12 @@ osc::CommandLine commandLine(Options* o) {
   cli.option("--right-info", &o->right_info, "TOPIC",
              "right CameraInfo (default NS/right/camera_info)");
   cli.option("--odom", &o->odom, "TOPIC", "vehicle odometry (nav_msgs/Odometry)");
+  cli.option("--oxts-position", &o->oxts_position, "SOURCE",
+             "KITTI raw: positions from the integrated OXTS velocity or from GPS (Mercator)")
+      .choices({"velocity", "gps"});
+  cli.option("--oxts-max-gap", &o->oxts_max_gap, "S",
+             "KITTI raw: missing OXTS records are interpolated over at most this (s)")
+      .range(0.01, 10.0);
   cli.option("--frames", &o->max_pairs, "N", "evaluate only the first N stereo pairs")
       .range(1, 1e9)
       .defaultText("all");
@@ -93,7 +118,21 @@ osc::CommandLine commandLine(Options* o) {
 }
 
 /// Checks the option combinations and fills the topics left to the namespace.
-void finishOptions(Options* o) {
+void finishOptions(const osc::CommandLine& cli, Options* o) {
+  if (o->bag.empty() == o->kitti_raw.empty()) {
+    throw osc::CommandLineError(o->bag.empty() ? "give --bag DRIVE.bag or --kitti-raw DIR"
+                                               : "give --bag or --kitti-raw, not both");
+  }
+  const std::vector<std::string>& foreign = o->bag.empty() ? kBagOnlyOptions : kKittiOnlyOptions;
+  for (const std::string& name : foreign) {
+    if (cli.given(name)) {
+      throw osc::CommandLineError(
+          name + " applies to " + (o->bag.empty() ? "--bag" : "--kitti-raw") + " only" +
+          (o->bag.empty() && (name == "--reference" || name == "--truth-topic")
+               ? " (a KITTI raw drive's reference is KITTI's own calibration)"
+               : ""));
+    }
+  }
   if (!o->reference.empty() && !o->truth_topic.empty()) {
     throw osc::CommandLineError("give --reference or --truth-topic, not both");
   }
@@ -254,11 +293,22 @@ class BagSource : public osc::DriveSource {
   std::map<std::int64_t, sensor_msgs::ImageConstPtr> pending_left_, pending_right_;
 };
 
+/// The KITTI raw folder, read.
+std::unique_ptr<osc::KittiRawSource> kittiRawSource(const Options& options) {
+  osc::KittiRawOptions kitti;
+  kitti.position = osc::oxtsPositionSourceFromName(options.oxts_position);
+  kitti.max_oxts_gap = options.oxts_max_gap;
+  return std::make_unique<osc::KittiRawSource>(osc::readKittiRawDrive(options.kitti_raw, kitti));
+}
+
 /// The tool itself, after the command line.
 int evaluate(const Options& options) {
   cv::setNumThreads(options.threads);
   std::string guess_path = options.initial_guess;
-  if (guess_path.empty()) guess_path = osc::directoryOf(options.bag) + "/initial_guess.yaml";
+  if (guess_path.empty()) {
+    guess_path = options.bag.empty() ? options.kitti_raw + "/initial_guess.yaml"
+                                     : osc::directoryOf(options.bag) + "/initial_guess.yaml";
+  }
   if (!osc::isRegularFile(guess_path)) {
     throw std::invalid_argument("no initial guess: give --initial-guess GUESS.yaml");
   }
@@ -273,9 +323,24 @@ int evaluate(const Options& options) {
   run.window_last = options.window_last;
   run.max_pairs = options.max_pairs;
   run.progress_bar = isatty(STDERR_FILENO) != 0;
-  BagSource source(options);
-  source.describe(std::cerr, config.front_end.detector);
-  return osc::evaluateDrive(source, config, guess.extrinsics, run, std::cout, std::cerr);
+  std::unique_ptr<osc::DriveSource> source;
+  if (!options.bag.empty()) {
+    auto bag = std::make_unique<BagSource>(options);
+    bag->describe(std::cerr, config.front_end.detector);
+    source = std::move(bag);
+  } else {
+    auto kitti = kittiRawSource(options);
+    const osc::KittiRawDrive& drive = kitti->drive();
+    std::cerr << "evaluating " << drive.summary() << "  " << config.front_end.detector
+              << " front end\n";
+    for (const std::string& line : drive.skippedLines()) std::cerr << "  skipped " << line << "\n";
+    run.notes.push_back("Frames of " + options.kitti_raw + " skipped by the reader (" +
+                        std::to_string(drive.skipped.size()) + "; the CSV's frame counts the " +
+                        std::to_string(drive.frames.size()) + " pairs used):");
+    for (const std::string& line : drive.skippedLines()) run.notes.push_back("  " + line);
+    source = std::move(kitti);
+  }
+  return osc::evaluateDrive(*source, config, guess.extrinsics, run, std::cout, std::cerr);
 }
 
 }  // namespace
@@ -287,7 +352,7 @@ int main(int argc, char** argv) {
       "evaluate", [&] { return cli.usage(); },
       [&] {
         if (!cli.parse(argc, argv)) return 0;
-        finishOptions(&parsed);
+        finishOptions(cli, &parsed);
         return evaluate(parsed);
       });
 }
