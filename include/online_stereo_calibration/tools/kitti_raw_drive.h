@@ -3,7 +3,7 @@
 /// the package's terms: the grey stereo pair image_00 (left) / image_01 (right), the vehicle
 /// motion from the OXTS GPS/INS records, and KITTI's calibration chain as the reference.
 ///
-/// The folder (KITTI's layout, docs/evaluation.md "KITTI raw drives"):
+/// The folder (KITTI's layout; docs/evaluation.md "evaluate on a KITTI raw drive"):
 /// ```
 /// image_00/data/NNNNNNNNNN.png  image_00/timestamps.txt    left grey camera
 /// image_01/data/NNNNNNNNNN.png  image_01/timestamps.txt    right grey camera

@@ -14,6 +14,7 @@
 
 namespace osc {
 
+/// A read drive (readKittiRawDrive) as a DriveSource; owns it.
 class KittiRawSource : public DriveSource {
  public:
   explicit KittiRawSource(KittiRawDrive drive) : drive_(std::move(drive)) {}
