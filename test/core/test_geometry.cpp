@@ -396,6 +396,24 @@ TEST(Pose, RotationBodyOpticalMapsTheOpticalAxesToTheBodyAxes) {
   EXPECT_TRUE(matrixNear(T.translation(), Eigen::Vector3d::Zero(), 0.0));
 }
 
+TEST(Pose, FromOpticalFramesInvertsThePublishedTransforms) {
+  Vector12d p;
+  p << 1.2, -0.3, 0.7, 0.02, -0.05, 0.3, 0.01, -0.54, 0.004, 0.003, -0.01, 0.02;
+  const StereoExtrinsics e = StereoExtrinsics::fromParameters(p);
+  const StereoExtrinsics back =
+      StereoExtrinsics::fromOpticalFrames(e.vehicleToLeftOptical(), e.leftToRightOptical());
+  EXPECT_TRUE(matrixNear(back.toParameters(), p, 1e-12));
+  // A left optical frame whose z (viewing direction) is the vehicle's x: the body frame is the
+  // vehicle's own, so all six parameters are zero; a right one 0.5 m along optical +x: yr -0.5.
+  Eigen::Isometry3d T_lopt_ropt = Eigen::Isometry3d::Identity();
+  T_lopt_ropt.translation() = Eigen::Vector3d(0.5, 0, 0);
+  const Vector12d level = StereoExtrinsics::fromOpticalFrames(bodyFromOptical(), T_lopt_ropt)
+                              .toParameters();
+  Vector12d expected = Vector12d::Zero();
+  expected(7) = -0.5;
+  EXPECT_TRUE(matrixNear(level, expected, 1e-15));
+}
+
 TEST(Pose, HorizontalRigPutsTheRightCameraAtPlusXInTheLeftOpticalFrame) {
   for (double b : {0.05, 0.12, 0.5}) {
     Vector12d p = Vector12d::Zero();

@@ -88,6 +88,15 @@ Vector12d StereoExtrinsics::toParameters() const {
   return p;
 }
 
+StereoExtrinsics StereoExtrinsics::fromOpticalFrames(const Eigen::Isometry3d& T_veh_lopt,
+                                                     const Eigen::Isometry3d& T_lopt_ropt) {
+  const Eigen::Isometry3d T_body_optical = bodyFromOptical();
+  StereoExtrinsics e;
+  e.T_veh_caml = T_veh_lopt * T_body_optical.inverse();
+  e.T_caml_camr = T_body_optical * T_lopt_ropt * T_body_optical.inverse();
+  return e;
+}
+
 Eigen::Isometry3d StereoExtrinsics::vehicleToLeftOptical() const {
   return T_veh_caml * bodyFromOptical();
 }

@@ -55,6 +55,10 @@ struct StereoExtrinsics {
   static StereoExtrinsics fromParameters(const Vector12d& parameters);
   /// To the interface's 12 parameters.
   Vector12d toParameters() const;
+  /// From the two optical-frame transforms (the inverse of vehicleToLeftOptical() and
+  /// leftToRightOptical()): T_veh_lopt and T_lopt_ropt.
+  static StereoExtrinsics fromOpticalFrames(const Eigen::Isometry3d& T_veh_lopt,
+                                            const Eigen::Isometry3d& T_lopt_ropt);
 
   /// T_veh_lopt: vehicle frame <- left optical frame (the published tf).
   Eigen::Isometry3d vehicleToLeftOptical() const;
