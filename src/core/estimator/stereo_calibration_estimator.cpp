@@ -68,6 +68,14 @@ void StereoCalibrationEstimator::followFilter() {
     monitor_reopenings_ = filter_.reopenings();
     monitor_.clearWindow();  // the evidence was the re-opened block's old calibration
   }
+  setFilterDriftInflation();
+}
+
+void StereoCalibrationEstimator::setFilterDriftInflation() {
+  // Set as soon as the monitor changes: the front end's predictObservations before the next
+  // step predicts with them, and the step reuses that prediction.
+  filter_.setDriftInflation({monitor_.inflation(ConsistencyBlock::kVehicleToLeft),
+                             monitor_.inflation(ConsistencyBlock::kLeftToRight)});
 }
 
 bool StereoCalibrationEstimator::restartIfLinearizedFarOff(FrameReport* report) {
@@ -214,8 +222,6 @@ FrameReport StereoCalibrationEstimator::processFrame(
     }
     held_for_few_points_ = report.too_few_points;
     gap_check_.beforeStep(&monitor_, !tracked.empty());
-    filter_.setDriftInflation({monitor_.inflation(ConsistencyBlock::kVehicleToLeft),
-                               monitor_.inflation(ConsistencyBlock::kLeftToRight)});
     report.step = filter_.step(motion, tracked, [this](const GateOutcome& gate) {
       return jump_test_.decide(gate, filter_);
     });
@@ -224,6 +230,7 @@ FrameReport StereoCalibrationEstimator::processFrame(
       followFilter();  // a jump's re-opening ends the monitor's window before its update
       monitor_.addUpdate(motion.dt, filter_.lastUpdateScores());
       report.consistency = monitor_.status();
+      setFilterDriftInflation();
     }
     if (!report.step.accepted) {
       // Without a usable motion the points cannot be predicted: start tracking afresh.

@@ -183,6 +183,8 @@ class StereoCalibrationEstimator {
   /// The consistency monitor follows the filter: a start since the last call resets it, a
   /// re-opening empties its window. Called after every call that may start or re-open.
   void followFilter();
+  /// The monitor's drift-noise factors onto the filter (after every change of the monitor).
+  void setFilterDriftInflation();
   /// While no point can be initialised: BaselineRestart's pair, and x_camr re-seeded at the
   /// length from motion when it proposes it (FilterConfig::baseline_from_motion).
   void learnBaselineLength(const MotionIncrement& motion, bool motion_links_pairs,

@@ -188,8 +188,13 @@ class CalibrationFilter {
   /// a component whose evidence a re-opening ends (the consistency monitor) compares it.
   int reopenings() const { return reopenings_; }
   /// The factors on x_caml's and x_camr's random walk (eq. 10-13) from the next prediction
-  /// on (the consistency monitor's; 1 = as configured).
-  void setDriftInflation(const std::array<double, 2>& factors) { drift_inflation_ = factors; }
+  /// on (the consistency monitor's; 1 = as configured). A prediction kept by
+  /// predictObservations with other factors is dropped.
+  void setDriftInflation(const std::array<double, 2>& factors) {
+    if (factors == drift_inflation_) return;
+    drift_inflation_ = factors;
+    last_prediction_.reset();
+  }
   /// How much of the recent vehicle rotation is excitation, per axis (MotionExcitation).
   Eigen::Vector3d excitationGains() const { return excitation_.gains(); }
 
