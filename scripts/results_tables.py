@@ -191,6 +191,61 @@ def kitti_table(log):
                  dt[0], dt[1]))
 
 
+# How well the KITTI raw drive's truth is known, 1 sigma per parameter (m, rad): its README
+# (xl 0.07 m, yl and zl 0.05 m, x_caml's angles 0.3-0.4 deg, taken 0.4; x_camr 2 mm, 0.03 deg).
+KITTI_RAW_TRUTH_SIGMA = [0.07, 0.05, 0.05] + [math.radians(0.4)] * 3 + [0.002] * 3 + \
+    [math.radians(0.03)] * 3
+
+
+def kitti_raw_table(directory, first=30):
+    """evaluate --kitti-raw's estimates.csv against its reference.csv (KITTI's chain): the last
+    pair's error and 1 sigma per parameter, and from pair @p first on the share of pairs within
+    3 and beyond 5 of the sigma with the truth's own added."""
+    names = ["xl", "yl", "zl", "roll_l", "pitch_l", "yaw_l", "xr", "yr", "zr", "roll_r",
+             "pitch_r", "yaw_r"]
+    with open(os.path.join(directory, "estimates.csv")) as f:
+        estimates = {int(r["frame"]): r for r in csv.DictReader(f)}
+    with open(os.path.join(directory, "reference.csv")) as f:
+        reference = {int(r["frame"]): r for r in csv.DictReader(f)}
+    frames = sorted(k for k in estimates if k in reference)
+    if not frames:
+        sys.exit("results_tables: %s has no pair with a reference" % directory)
+    judged = [k for k in frames if k >= first]
+    last = frames[-1]
+
+    def shown(p, value):  # mm / deg / m as the interface reads them
+        if p in (6, 7, 8):
+            return "%+.1f mm" % (1e3 * value), "%.1f" % (1e3 * value)
+        if p < 3:
+            return "%+.3f m" % value, "%.3f" % value
+        return "%+.3f°" % math.degrees(value), "%.3f" % math.degrees(value)
+
+    print("| at the last pair (%d) | error ± 1σ | within 3σ from pair %d (truth's σ added) | "
+          "beyond 5σ |" % (last, first))
+    print("|---|---|---|---|")
+    every_within, every_beyond = 0, 0
+    within_all = [True] * len(judged)
+    for p, name in enumerate(names):
+        error = float(estimates[last][name]) - float(reference[last][name])
+        sigma = float(estimates[last]["sigma_" + name])
+        within = beyond = 0
+        for i, k in enumerate(judged):
+            e = float(estimates[k][name]) - float(reference[k][name])
+            s = math.hypot(float(estimates[k]["sigma_" + name]), KITTI_RAW_TRUTH_SIGMA[p])
+            within += abs(e) <= 3 * s
+            beyond += abs(e) > 5 * s
+            within_all[i] = within_all[i] and abs(e) <= 3 * s
+        e_text = shown(p, error)[0]
+        s_text = shown(p, sigma)[1]
+        print("| %s | %s ± %s | %.0f %% | %d |" % (name, e_text, s_text,
+                                                 100.0 * within / max(1, len(judged)), beyond))
+        every_beyond += beyond
+    print("\nAll 12 within 3σ (truth's σ added) in %d of %d pairs from pair %d on (%.0f %%); "
+          "%d parameter-pairs beyond 5σ." % (sum(within_all), len(judged), first,
+                                             100.0 * sum(within_all) / max(1, len(judged)),
+                                             every_beyond))
+
+
 def splice(document, directory, stamp):
     """Replaces the text between each <!-- results:NAME --> and <!-- /results:NAME --> of
     @p document with DIRECTORY/NAME.md, under a line saying where it was measured."""
@@ -230,6 +285,8 @@ def main():
     camp.add_argument("--perfect-runs", type=int, default=2000)
     kit = sub.add_parser("kitti")
     kit.add_argument("log")
+    raw = sub.add_parser("kitti_raw")
+    raw.add_argument("directory")
     spl = sub.add_parser("splice")
     spl.add_argument("document")
     spl.add_argument("directory")
@@ -242,6 +299,8 @@ def main():
         rmse_table(args.directories, args.window[0], args.window[1])
     elif args.command == "kitti":
         kitti_table(args.log)
+    elif args.command == "kitti_raw":
+        kitti_raw_table(args.directory)
     elif args.command == "splice":
         splice(args.document, args.directory, args.stamp)
     elif args.command == "ablation":

@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include "online_stereo_calibration/core/estimator/epipolar_consistency.h"
+#include "online_stereo_calibration/core/estimator/hand_eye_start.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
@@ -101,39 +102,15 @@ bool StereoCalibrationEstimator::restartFromMotion(
                              &restart)) {
     return false;
   }
-  // A fresh start from the guess, with the hand-eye rotation for x_caml's: everything learned
-  // so far was learned with x_caml's rotation far off (x_camr too: in the first frames the
-  // filter explains the wrong rotation's mispredictions partly with x_camr, 36 sigma off in
-  // yr after one frame with a backward camera guessed forward). A camera whose rotation was
-  // guessed this far off is likely elsewhere too (at the tailgate, under a mirror): its
-  // translation starts from the guess with at least hand_eye_restart_translation_sigma.
-  // x_camr: the guess's covariance (the config's start sigmas, or a saved calibration's).
-  StereoExtrinsics start = guess_;
-  start.T_veh_caml.linear() = restart.R_veh_caml;
   for (const PointEstimate& p : filter_.points()) report->dropped.push_back(p.id);
-  covariance = guess_covariance_;
-  covariance.template middleRows<kPoseDim>(kCaml).setZero();
-  covariance.template middleCols<kPoseDim>(kCaml).setZero();
-  const double translation_sigma =
-      std::max(config_.initial_caml_translation_sigma, config_.hand_eye_restart_translation_sigma);
-  covariance.template block<3, 3>(kCaml + kTranslation, kCaml + kTranslation) =
-      Eigen::Matrix3d::Identity() * translation_sigma * translation_sigma;
-  covariance.template block<3, 3>(kCaml + kRotation, kCaml + kRotation) = restart.covariance;
-  filter_.reset(start, covariance);
+  const HandEyeStart start = handEyeStart(
+      restart, now, guess_, Matrix12d(guess_covariance_),
+      std::max(config_.initial_caml_translation_sigma, config_.hand_eye_restart_translation_sigma));
+  filter_.reset(start.extrinsics, start.covariance);
   followFilter();
   // A start: both blocks re-linearised as after one.
   restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
-  const Eigen::Vector3d before = rpyFromRotation(now.T_veh_caml.linear()) * 180.0 / M_PI;
-  const Eigen::Vector3d after = rpyFromRotation(restart.R_veh_caml) * 180.0 / M_PI;
-  std::ostringstream message;
-  message.precision(4);
-  message << "mounting rotation from motion: x_caml restarted from roll/pitch/yaw " << after(0)
-          << "/" << after(1) << "/" << after(2) << " deg (was " << before(0) << "/" << before(1)
-          << "/" << before(2) << " deg, " << restart.distance << " sigmas apart; hand-eye "
-          << restart.hand_eye.reason
-          << "); everything else from the guess again, translation 1 sigma " << translation_sigma
-          << " m; tracks reset";
-  report->events.add(FrameEvent::kMountingRotationFromMotion, message.str());
+  report->events.add(FrameEvent::kMountingRotationFromMotion, start.message);
   return true;
 }
 
