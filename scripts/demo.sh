@@ -74,6 +74,7 @@ fi
 simulator_sources=(src/core/sim include/online_stereo_calibration/core/sim
   src/core/geometry include/online_stereo_calibration/core/geometry
   src/tools/lib/drive_simulation.cpp src/tools/lib/scenario_file.cpp
+  src/tools/lib/scenario_file_sections.cpp src/tools/lib/scenario_file_internal.h
   src/tools/lib/tum_trajectory.cpp include/online_stereo_calibration/tools/scenario_file.h
   include/online_stereo_calibration/tools/drive_simulation.h
   include/online_stereo_calibration/tools/tum_trajectory.h
