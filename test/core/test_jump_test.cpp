@@ -9,22 +9,16 @@
 #include "online_stereo_calibration/core/estimator/jump_test.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
+#include "test_intrinsics.h"
 
 namespace osc {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-StereoIntrinsics intrinsics() {
-  StereoIntrinsics k;
-  k.K_left << 600, 0, 320, 0, 600, 240, 0, 0, 1;
-  k.K_right = k.K_left;
-  return k;
-}
-
 /// A filter whose blocks are known to 1 mm and 0.06 deg: both may be re-opened.
 struct Bench {
-  CalibrationFilter filter{FilterConfig(), intrinsics()};
+  CalibrationFilter filter{FilterConfig(), testIntrinsics()};
   JumpTestOptions options = JumpTestOptions::from(FilterConfig());
 
   Bench() { start(); }
@@ -102,7 +96,7 @@ TEST(JumpTest, ASmallerShareInSeveralFramesInARowIsAJumpOnceTheBlockHasSettled) 
 
 /// Every point seen turned by @p R_optical (measured bearing = R_optical x predicted).
 GateOutcome turnedGate(const Eigen::Matrix3d& R_optical, double noise_px, std::mt19937* rng) {
-  const Eigen::Matrix3d K = intrinsics().K_left;
+  const Eigen::Matrix3d K = testIntrinsics().K_left;
   std::normal_distribution<double> noise(0.0, noise_px);
   GateOutcome outcome = gate(30, 30, 30);
   for (GatedPoint& point : outcome.points) {

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "online_stereo_calibration/core/estimator/left_camera_gap_check.h"
+#include "test_intrinsics.h"
 
 namespace osc {
 namespace {
@@ -38,12 +39,7 @@ ConsistencyStatus status(bool exceeded = false, int window_updates = 0) {
 }
 
 struct Bench {
-  CalibrationFilter filter{FilterConfig(), [] {
-                             StereoIntrinsics k;
-                             k.K_left << 600, 0, 320, 0, 600, 240, 0, 0, 1;
-                             k.K_right = k.K_left;
-                             return k;
-                           }()};
+  CalibrationFilter filter{FilterConfig(), testIntrinsics()};
   LeftCameraGapCheck check{LeftCameraGapCheckOptions::from(FilterConfig())};
   ConsistencyMonitor monitor{FilterConfig()};
 

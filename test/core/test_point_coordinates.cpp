@@ -10,18 +10,12 @@
 #include "online_stereo_calibration/core/filter/process_model.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
+#include "test_intrinsics.h"
 
 namespace osc {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-
-StereoIntrinsics intrinsics600() {
-  StereoIntrinsics K;
-  K.K_left << 600, 0, 320, 0, 600, 240, 0, 0, 1;
-  K.K_right = K.K_left;
-  return K;
-}
 
 /// A 0.3 m rig looking forward from 1.3 m, the right camera turned a little.
 StereoExtrinsics smallRig() {
@@ -58,7 +52,7 @@ TEST(PointCoordinates, InverseDepthRoundTripsAndItsJacobianIsTheDerivative) {
 }
 
 TEST(PointCoordinates, HomogeneousModelsAgreeWithThePositionModels) {
-  const StereoIntrinsics K = intrinsics600();
+  const StereoIntrinsics K = testIntrinsics();
   const StereoExtrinsics rig = smallRig();
   Vector6d w;
   w << 0.4, 0.05, 0.01, 0.01, -0.02, 0.03;
@@ -92,7 +86,7 @@ TEST(PointCoordinates, HomogeneousModelsAgreeWithThePositionModels) {
 }
 
 TEST(PointCoordinates, InverseDepthTriangulationIsExactAndDefinedBeyondInfinity) {
-  const StereoIntrinsics K = intrinsics600();
+  const StereoIntrinsics K = testIntrinsics();
   const StereoExtrinsics rig = smallRig();
   const Eigen::Isometry3d T_lopt_ropt = rig.leftToRightOptical();
   const Eigen::Vector3d p(-2.0, 0.7, 25.0);

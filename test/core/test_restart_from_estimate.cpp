@@ -6,18 +6,12 @@
 #include <cmath>
 
 #include "online_stereo_calibration/core/estimator/restart_from_estimate.h"
+#include "test_intrinsics.h"
 
 namespace osc {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-
-StereoIntrinsics intrinsics() {
-  StereoIntrinsics k;
-  k.K_left << 600, 0, 320, 0, 600, 240, 0, 0, 1;
-  k.K_right = k.K_left;
-  return k;
-}
 
 StereoExtrinsics rig() {
   Vector12d p;
@@ -45,7 +39,7 @@ StepReport stepAt(double nis_per_dof, int points = 20) {
 /// A filter started at rig() whose estimate then moved xl by @p xl_sigmas start sigmas, with
 /// a covariance 100 times smaller than the start's (it converged there).
 struct MovedFilter {
-  CalibrationFilter filter{FilterConfig(), intrinsics()};
+  CalibrationFilter filter{FilterConfig(), testIntrinsics()};
   RestartFromEstimate restart{RestartFromEstimateOptions()};
 
   explicit MovedFilter(double xl_sigmas) {
@@ -119,7 +113,7 @@ TEST(RestartFromEstimate, AtMostMaxRestartsAndOffWithZeroFrames) {
   EXPECT_EQ(restarts, options.max_restarts);
 
   options.frames = 0;
-  CalibrationFilter filter(FilterConfig(), intrinsics());
+  CalibrationFilter filter(FilterConfig(), testIntrinsics());
   filter.reset(rig(), startCovariance());
   RestartFromEstimate off(options);
   off.anchorHere(filter, JumpBlock::kNone, Vector6d::Zero());
@@ -131,7 +125,7 @@ TEST(RestartFromEstimate, AtMostMaxRestartsAndOffWithZeroFrames) {
 
 TEST(RestartFromEstimate, AfterAReopeningOnlyTheReopenedComponentsAreCheckedAndRestarted) {
   // x_camr's rotation re-opened to 1 deg; its translation converged (1 mm) is not checked.
-  CalibrationFilter filter(FilterConfig(), intrinsics());
+  CalibrationFilter filter(FilterConfig(), testIntrinsics());
   Matrix12d converged = startCovariance() / 10000.0;
   filter.reset(rig(), converged);
   RestartFromEstimate restart{RestartFromEstimateOptions()};

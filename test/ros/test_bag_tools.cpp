@@ -22,6 +22,7 @@
 #include "online_stereo_calibration/tools/evaluation.h"
 #include "online_stereo_calibration/tools/scenario_file.h"
 #include "online_stereo_calibration/tools/tum_trajectory.h"
+#include "tool_test_helpers.h"
 
 namespace {
 
@@ -33,32 +34,8 @@ Eigen::Isometry3d pose(double x, double y, double z, double roll, double pitch, 
 
 bool isFile(const std::string& path) { return std::ifstream(path).good(); }
 
-/// Directory of the running test binary (catkin puts the executables next to it).
-std::string executableDirectory() {
-  char buffer[4096];
-  const ssize_t n = readlink("/proc/self/exe", buffer, sizeof buffer - 1);
-  if (n <= 0) return ".";
-  std::string path(buffer, n);
-  return path.substr(0, path.find_last_of('/'));
-}
-
-/// Path of a built tool: next to the test binary or in the catkin devel lib folder.
-std::string findTool(const std::string& name) {
-  const std::string dir = executableDirectory();
-  for (const std::string& c : {dir + "/" + name, dir + "/../lib/online_stereo_calibration/" + name,
-                               dir + "/devel/lib/online_stereo_calibration/" + name,
-                               dir + "/../devel/lib/online_stereo_calibration/" + name}) {
-    if (access(c.c_str(), X_OK) == 0) return c;
-  }
-  return "";
-}
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using osc_test::findTool;
+using osc_test::readText;
 
 }  // namespace
 

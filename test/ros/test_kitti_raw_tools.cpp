@@ -18,31 +18,14 @@
 #include "online_stereo_calibration/tools/calibration_file.h"
 #include "online_stereo_calibration/tools/estimates_csv.h"
 #include "online_stereo_calibration/tools/kitti_raw_drive.h"
+#include "tool_test_helpers.h"
 
 namespace {
 
 const std::string kDrive = std::string(OSC_SOURCE_DIR) + "/../shared/data/kitti_raw_2011_09_26_200";
 
-/// Path of a built tool: next to the test binary or in the catkin devel lib folder.
-std::string findTool(const std::string& name) {
-  char buffer[4096];
-  const ssize_t n = readlink("/proc/self/exe", buffer, sizeof buffer - 1);
-  const std::string path = n > 0 ? std::string(buffer, static_cast<std::size_t>(n)) : "./x";
-  const std::string dir = path.substr(0, path.find_last_of('/'));
-  for (const std::string& c : {dir + "/" + name, dir + "/../lib/online_stereo_calibration/" + name,
-                               dir + "/devel/lib/online_stereo_calibration/" + name,
-                               dir + "/../devel/lib/online_stereo_calibration/" + name}) {
-    if (access(c.c_str(), X_OK) == 0) return c;
-  }
-  return "";
-}
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using osc_test::findTool;
+using osc_test::readText;
 
 /// Runs @p tool with @p arguments, stdout and stderr into @p log; the exit code.
 int run(const std::string& tool, const std::string& arguments, const std::string& log) {
