@@ -12,9 +12,9 @@
   results_tables.py ablation DIR VARIANT [VARIANT ...]
       scripts/ablation.sh's table: per variant (DIR/VARIANT/{drawn,phase0,po}) the campaigns'
       honest runs and frames beyond 5 sigma and paper_offroad's RMSE relative to `shipped`.
-  results_tables.py campaign DIR [--perfect-runs N]
+  results_tables.py campaign DIR
       A campaign's honesty (campaign.csv) beside what a perfectly consistent filter scores on
-      the same number of frames (scripts/honest_by_chance.py's models).
+      the same number of frames, as the campaign printed it (summary.txt, perfect_filter.h).
 
 The campaign table's columns: honest runs (all 12 errors within 3 sigma in >= 95 % of the
 frames from frame 30 on and none beyond 5 sigma), runs with a frame beyond 5 sigma, those
@@ -28,8 +28,6 @@ import os
 import sys
 
 import numpy as np
-
-import honest_by_chance
 
 NAMES = ["xl", "yl", "zl", "roll_l", "pitch_l", "yaw_l",
          "xr", "yr", "zr", "roll_r", "pitch_r", "yaw_r"]
@@ -118,7 +116,21 @@ def ablation_table(directory, variants, first=1000, last=1150):
                                                       NAMES[largest], ratio[4]))
 
 
-def campaign_table(directory, perfect_runs):
+def perfect_filter_line(directory):
+    """What the campaign printed for a perfect filter on its runs' frames (summary.txt; the
+    model of tools/perfect_filter.h): honest share range, share of runs beyond 5 sigma, mean
+    share within 3 sigma, as printed."""
+    import re
+    path = os.path.join(directory, "summary.txt")
+    text = open(path).read() if os.path.exists(path) else ""
+    m = re.search(r"honest in (\d+)-(\d+) % of the runs, some frame beyond 5 sigma in "
+                  r"([0-9.]+) %, mean share within 3 sigma ([0-9.]+)", text)
+    if not m:
+        sys.exit("results_tables: %s has no perfect-filter line (rerun the campaign)" % path)
+    return m.groups()
+
+
+def campaign_table(directory):
     with open(os.path.join(directory, "campaign.csv")) as f:
         rows = list(csv.DictReader(f))
     ok = [r for r in rows if r["status"] == "ok"]
@@ -133,18 +145,7 @@ def campaign_table(directory, perfect_runs):
     honest = int(np.sum((share >= 0.95) & (beyond == 0)))
     n = len(rows)
 
-    rng = np.random.default_rng(1)
-    perfect = []
-    for model in ["constant", 30.0, 100.0, 300.0]:
-        if model == "constant":
-            z = honest_by_chance.constant_model(rng, perfect_runs, frames)
-        else:
-            z = honest_by_chance.ar_model(rng, perfect_runs, frames, model)
-        p_share, p_max = honest_by_chance.scores(z)
-        perfect.append((np.mean((p_share >= 0.95) & (p_max <= 5.0)), np.mean(p_max > 5.0),
-                        p_share.mean()))
-    lo = min(p[0] for p in perfect)
-    hi = max(p[0] for p in perfect)
+    perfect = perfect_filter_line(directory)
     print("| %d runs x %d frames | honest | runs beyond 5σ | frames beyond 5σ (unseen) "
           "| mean share within 3σ | CONVERGED frames beyond 3σ |" % (n, frames))
     print("|---|---|---|---|---|---|")
@@ -152,9 +153,7 @@ def campaign_table(directory, perfect_runs):
           % (honest, n, 100.0 * honest / n, int(np.sum(beyond > 0)), 100.0 * np.mean(beyond > 0),
              int(beyond.sum()), int(unseen.sum()), share.mean(), converged_off, converged,
              100.0 * converged_off / max(converged, 1)))
-    print("| a perfect filter | %.0f-%.0f %% | %.1f %% | - | %.3f | ~3 %% |"
-          % (100.0 * lo, 100.0 * hi, 100.0 * max(p[1] for p in perfect),
-             np.mean([p[2] for p in perfect])))
+    print("| a perfect filter | %s-%s %% | %s %% | - | %s | ~3 %% |" % perfect)
     failed = n - len(ok)
     if failed:
         print("\n%d runs failed (status in campaign.csv)." % failed)
@@ -282,7 +281,6 @@ def main():
     rmse.add_argument("--window", type=int, nargs=2, default=[1000, 1150])
     camp = sub.add_parser("campaign")
     camp.add_argument("directory")
-    camp.add_argument("--perfect-runs", type=int, default=2000)
     kit = sub.add_parser("kitti")
     kit.add_argument("log")
     raw = sub.add_parser("kitti_raw")
@@ -306,7 +304,7 @@ def main():
     elif args.command == "ablation":
         ablation_table(args.directory, args.variants)
     else:
-        campaign_table(args.directory, args.perfect_runs)
+        campaign_table(args.directory)
 
 
 if __name__ == "__main__":
