@@ -7,6 +7,9 @@
       paper's Table I; angles wrapped to +-180 deg.
   results_tables.py kitti LOG
       The last printed frame of each KITTI sequence of test_kitti's diagnostic, as a table.
+  results_tables.py kitti_raw DIR
+      evaluate --kitti-raw's output against KITTI's chain: the last pair's error and sigma, and
+      the share of pairs from pair 30 on within 3 sigma with the truth's own sigma added.
   results_tables.py splice DOC DIR --stamp TEXT
       Puts each DIR/NAME.md into DOC between its <!-- results:NAME --> markers.
   results_tables.py ablation DIR VARIANT [VARIANT ...]
