@@ -160,7 +160,7 @@ class StereoCalibrationEstimator {
   /// @p extrinsics (FilterConfig::odometry_scale_sigma; zero when 0).
   Matrix12d odometryScaleCovariance(const StereoExtrinsics& extrinsics) const;
   /// The linearisation guard's restart (restart_from_estimate.h) after an accepted step:
-  /// every point dropped into report->dropped, FrameReport::relinearized and its warning.
+  /// every point dropped into report->dropped, the event FrameEvent::kRelinearized.
   /// True if it restarted.
   bool restartIfLinearizedFarOff(FrameReport* report);
   /// The gap check (left_camera_gap_check.h) after an accepted step without a jump: x_caml
