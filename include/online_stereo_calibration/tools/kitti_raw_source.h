@@ -9,10 +9,26 @@
 #include <string>
 #include <vector>
 
+#include "online_stereo_calibration/tools/command_line.h"
 #include "online_stereo_calibration/tools/drive_evaluation.h"
 #include "online_stereo_calibration/tools/kitti_raw_drive.h"
 
 namespace osc {
+
+/// The reader's options on a tool's command line (--oxts-position, --oxts-max-gap): one
+/// definition for `evaluate --kitti-raw` and `kitti_raw_to_bag`. Lives as long as the
+/// CommandLine it was added to (the options write into it).
+class KittiRawCommandLine {
+ public:
+  /// @p help_prefix: put before each option's help (e.g. "KITTI raw: ").
+  void addTo(CommandLine* cli, const std::string& help_prefix = "");
+  /// The parsed values as the reader's options (the other fields at their defaults).
+  KittiRawOptions options() const;
+
+ private:
+  std::string position_ = "velocity";
+  double max_oxts_gap_ = KittiRawOptions().max_oxts_gap;
+};
 
 /// A read drive (readKittiRawDrive) as a DriveSource; owns it.
 class KittiRawSource : public DriveSource {

@@ -8,6 +8,22 @@
 
 namespace osc {
 
+void KittiRawCommandLine::addTo(CommandLine* cli, const std::string& help_prefix) {
+  cli->option("--oxts-position", &position_, "SOURCE",
+              help_prefix + "positions from the integrated OXTS velocity or from GPS (Mercator)")
+      .choices({"velocity", "gps"});
+  cli->option("--oxts-max-gap", &max_oxts_gap_, "S",
+              help_prefix + "missing OXTS records are interpolated over at most this (s)")
+      .range(0.01, 10.0);
+}
+
+KittiRawOptions KittiRawCommandLine::options() const {
+  KittiRawOptions options;
+  options.position = oxtsPositionSourceFromName(position_);
+  options.max_oxts_gap = max_oxts_gap_;
+  return options;
+}
+
 bool KittiRawSource::next(StereoPairInput* pair) {
   if (next_ >= drive_.frames.size()) return false;
   const KittiRawFrame& frame = drive_.frames[next_++];

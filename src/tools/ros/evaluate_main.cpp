@@ -53,8 +53,7 @@ struct Options {
   std::string stereo_ns = "/stereo";
   std::string left_image, right_image, left_info, right_info, odom = "/odom";
   /// KITTI raw: where the positions come from, and the longest OXTS gap bridged (s).
-  std::string oxts_position = "velocity";
-  double oxts_max_gap = osc::KittiRawOptions().max_oxts_gap;
+  osc::KittiRawCommandLine kitti_raw_reader;
 };
 
 /// Odometry further than this (s) beyond an image stamp is not extrapolated.
@@ -101,12 +100,7 @@ osc::CommandLine commandLine(Options* o) {
   cli.option("--right-info", &o->right_info, "TOPIC",
              "right CameraInfo (default NS/right/camera_info)");
   cli.option("--odom", &o->odom, "TOPIC", "vehicle odometry (nav_msgs/Odometry)");
-  cli.option("--oxts-position", &o->oxts_position, "SOURCE",
-             "KITTI raw: positions from the integrated OXTS velocity or from GPS (Mercator)")
-      .choices({"velocity", "gps"});
-  cli.option("--oxts-max-gap", &o->oxts_max_gap, "S",
-             "KITTI raw: missing OXTS records are interpolated over at most this (s)")
-      .range(0.01, 10.0);
+  o->kitti_raw_reader.addTo(&cli, "KITTI raw: ");
   cli.option("--frames", &o->max_pairs, "N", "evaluate only the first N stereo pairs")
       .range(1, 1e9)
       .defaultText("all");
@@ -295,10 +289,8 @@ class BagSource : public osc::DriveSource {
 
 /// The KITTI raw folder, read.
 std::unique_ptr<osc::KittiRawSource> kittiRawSource(const Options& options) {
-  osc::KittiRawOptions kitti;
-  kitti.position = osc::oxtsPositionSourceFromName(options.oxts_position);
-  kitti.max_oxts_gap = options.oxts_max_gap;
-  return std::make_unique<osc::KittiRawSource>(osc::readKittiRawDrive(options.kitti_raw, kitti));
+  return std::make_unique<osc::KittiRawSource>(
+      osc::readKittiRawDrive(options.kitti_raw, options.kitti_raw_reader.options()));
 }
 
 /// The tool itself, after the command line.

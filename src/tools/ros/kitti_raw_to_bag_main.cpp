@@ -28,6 +28,7 @@
 #include "online_stereo_calibration/tools/bag_evaluation.h"
 #include "online_stereo_calibration/tools/command_line.h"
 #include "online_stereo_calibration/tools/kitti_raw_drive.h"
+#include "online_stereo_calibration/tools/kitti_raw_source.h"
 #include "online_stereo_calibration/tools/output_directory.h"
 
 namespace {
@@ -35,8 +36,7 @@ namespace {
 struct Options {
   std::string kitti_raw, out;
   int frames = -1;
-  std::string oxts_position = "velocity";
-  double oxts_max_gap = osc::KittiRawOptions().max_oxts_gap;
+  osc::KittiRawCommandLine reader;
 };
 
 osc::CommandLine commandLine(Options* o) {
@@ -50,12 +50,7 @@ osc::CommandLine commandLine(Options* o) {
   cli.option("--frames", &o->frames, "N", "write only the first N usable frames")
       .range(1, 1e9)
       .defaultText("all");
-  cli.option("--oxts-position", &o->oxts_position, "SOURCE",
-             "positions from the integrated OXTS velocity or from GPS (Mercator)")
-      .choices({"velocity", "gps"});
-  cli.option("--oxts-max-gap", &o->oxts_max_gap, "S",
-             "missing OXTS records are interpolated over at most this (s)")
-      .range(0.01, 10.0);
+  o->reader.addTo(&cli);
   return cli;
 }
 
@@ -76,10 +71,8 @@ std::string encodingOf(const cv::Mat& image) {
 }
 
 int convert(const Options& options) {
-  osc::KittiRawOptions kitti;
-  kitti.position = osc::oxtsPositionSourceFromName(options.oxts_position);
-  kitti.max_oxts_gap = options.oxts_max_gap;
-  const osc::KittiRawDrive drive = osc::readKittiRawDrive(options.kitti_raw, kitti);
+  const osc::KittiRawDrive drive =
+      osc::readKittiRawDrive(options.kitti_raw, options.reader.options());
   std::cerr << "converting " << drive.summary();
   for (const std::string& line : drive.skippedLines()) std::cerr << "  skipped " << line << "\n";
   std::size_t frames = drive.frames.size();
