@@ -72,10 +72,12 @@ done
 if [[ $build -eq 1 ]]; then bash scripts/build.sh; fi
 bin="${OSC_BUILD_DIR:-build}/devel/lib/online_stereo_calibration"
 [[ -x "$bin/campaign" ]] || { echo "ablation.sh: $bin/campaign not found; build first" >&2; exit 1; }
-trajectories="$(cd .. && pwd)/shared/data/trajectories"
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
-sed "s|^trajectories_dir: .*|trajectories_dir: $trajectories|" config/campaign.yaml > "$out/drawn.yaml"
+# The same absolute path that scripts/results.sh writes, so that its campaigns (the same
+# inputs) can stand in for `shipped` and resume here.
+sed "s|^trajectories_dir: .*|trajectories_dir: $(pwd)/config/../../shared/data/trajectories|" \
+  config/campaign.yaml > "$out/drawn.yaml"
 sed 's|^  yaw_phase_deg: \[0, 360\]|  yaw_phase_deg: 0       |' "$out/drawn.yaml" > "$out/phase0.yaml"
 grep -q '^  yaw_phase_deg: 0 ' "$out/phase0.yaml" ||
   { echo "ablation.sh: could not fix yaw_phase_deg in the ranges copy" >&2; exit 1; }
