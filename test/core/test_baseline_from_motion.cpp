@@ -218,5 +218,47 @@ TEST(BaselineRestart, AnUnknownLengthIsRestartedAtTheMeasuredOneAKnownOneIsNot) 
   EXPECT_FALSE(drive(&kept, known, 8).reseed);
 }
 
+// A slow camera (2 cm per pair: a MAV at 20 Hz in a room) moves too little between two pairs
+// for the length (min_translation 5 cm, then a pixel of parallax). The pairs are linked to an
+// earlier reference pair until the camera has moved enough since it, and the length is
+// measured; linking each pair to the one before, no pair would ever count.
+TEST(BaselineRestart, ASlowCameraIsLinkedToAnEarlierPairUntilItHasMovedEnough) {
+  const CalibrationFilter unknown = shortRigFilter(0.1);
+  BaselineRestart restart(FilterConfig(), unknown.intrinsics().K_left,
+                          unknown.intrinsics().K_right);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> lateral(-12.0, 12.0), height(-2.0, 3.0);
+  std::uniform_real_distribution<double> inverse_depth(1.0 / 30.0, 1.0 / 3.0);
+  std::normal_distribution<double> noise(0.0, 0.3);
+  std::vector<Eigen::Vector3d> scene;  // the first pair's left optical frame
+  while (scene.size() < 150) {
+    const double z = 1.0 / inverse_depth(rng);
+    const Eigen::Vector3d X(lateral(rng) * z / 20.0, height(rng), z);
+    if (std::abs(X.x() / X.z()) < 0.5) scene.push_back(X);
+  }
+  constexpr double kStep = 0.02;  // m forward per pair (vehicle x = the camera's optical z)
+  MotionIncrement motion;
+  motion.T_prev_curr.translation() = Eigen::Vector3d(kStep, 0.0, 0.0);
+  int reseeded_at = -1, kept = 0;
+  BaselineReseed reseed;
+  for (int k = 0; k < 60 && reseeded_at < 0; ++k) {
+    std::vector<PointMeasurement> candidates;
+    for (size_t i = 0; i < scene.size(); ++i) {
+      const Eigen::Vector3d X = scene[i] - Eigen::Vector3d(0.0, 0.0, k * kStep);
+      PointMeasurement m;
+      m.id = static_cast<PointId>(i);
+      m.z << kFocal * project(X), kFocal * project(X - Eigen::Vector3d(0.3, 0.0, 0.0));
+      for (int c = 0; c < 4; ++c) m.z(c) += noise(rng);
+      candidates.push_back(m);
+    }
+    reseed = restart.afterPair(motion, k > 0, candidates, unknown);
+    kept += restart.keepsReference();
+    if (reseed.reseed) reseeded_at = k;
+  }
+  ASSERT_GE(reseeded_at, 0) << restart.lengthSoFar().why << "; " << restart.lastWhy();
+  EXPECT_GE(kept, 5 * 2);  // five pairs counted, each after at least two kept
+  EXPECT_NEAR(reseed.T_caml_camr.translation().norm(), 0.3, 0.03);
+}
+
 }  // namespace
 }  // namespace osc

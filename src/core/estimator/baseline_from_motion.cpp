@@ -104,7 +104,9 @@ Eigen::Isometry3d withoutDisparityOffset(const Eigen::Isometry3d& T_lopt_ropt, d
 
 bool BaselineFromMotion::addPair(const std::vector<StereoLink>& links,
                                  const Eigen::Isometry3d& T_lopt_ropt, double camera_translation) {
+  last_lacked_parallax_ = false;
   if (!(camera_translation >= config_.min_translation)) {
+    last_lacked_parallax_ = true;
     std::ostringstream why;
     why << "the left camera moved " << camera_translation << " m (least " << config_.min_translation
         << ")";
@@ -118,6 +120,7 @@ bool BaselineFromMotion::addPair(const std::vector<StereoLink>& links,
   }
   const CameraMotion motion = estimateCameraMotion(previous, current, config_.motion);
   if (!motion.valid) {
+    last_lacked_parallax_ = motion.parallax > 0.0 && motion.parallax < config_.motion.min_parallax;
     last_why_ = "left camera motion: " + motion.why;
     return false;
   }
@@ -237,6 +240,7 @@ BaselineLength BaselineFromMotion::estimate() const {
 }
 
 void BaselineFromMotion::clear() {
+  last_lacked_parallax_ = false;
   sums_ = LineSums();
   inliers_ = 0;
   pair_lengths_.clear();

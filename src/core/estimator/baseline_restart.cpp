@@ -18,6 +18,9 @@ namespace {
 constexpr double kUnknownLengthShare = 0.3;
 /// The least 1 sigma of a length from motion, as a share of it (the fit's own sigma is doubled).
 constexpr double kLeastLengthSigma = 0.05;
+/// Pairs linked to one reference pair at most while the camera's parallax since it is too
+/// small (a hovering MAV): then the reference moves on.
+constexpr int kMostPairsOnOneReference = 20;
 
 BaselineFromMotionConfig measurementConfig(const FilterConfig& config,
                                            const Eigen::Matrix3d& K_left) {
@@ -46,6 +49,9 @@ void BaselineRestart::forget() {
   previous_candidates_.clear();
   given_links_.clear();
   links_given_ = false;
+  since_reference_ = Eigen::Isometry3d::Identity();
+  keeps_reference_ = false;
+  pairs_on_reference_ = 0;
 }
 
 BaselineReseed BaselineRestart::afterPair(const MotionIncrement& motion, bool motion_links_pairs,
@@ -68,17 +74,31 @@ BaselineReseed BaselineRestart::afterPair(const MotionIncrement& motion, bool mo
   }
   for (const auto& [previous, now] : given_links_)
     links.push_back({normalised(previous), normalised(now)});
-  previous_candidates_.swap(current);
   given_links_.clear();
   links_given_ = false;
-  if (!motion_links_pairs || links.empty()) return result;
-  // The left camera's motion between the pairs, at the odometry's scale (its length hardly
-  // depends on x_caml: only through the lever arm of the vehicle's rotation).
+  // The left camera's motion since the reference pair, at the odometry's scale (its length
+  // hardly depends on x_caml: only through the lever arm of the vehicle's rotation).
   const StereoExtrinsics& extrinsics = filter.extrinsics();
   const Eigen::Isometry3d& T_veh_caml = extrinsics.T_veh_caml;
-  const double moved =
-      (T_veh_caml.inverse() * motion.T_prev_curr * T_veh_caml).translation().norm();
-  measurement_.addPair(links, extrinsics.leftToRightOptical(), moved);
+  const Eigen::Isometry3d since_reference = since_reference_ * motion.T_prev_curr;
+  const bool linked = motion_links_pairs && !links.empty();
+  bool counted = false;
+  if (linked) {
+    const double moved = (T_veh_caml.inverse() * since_reference * T_veh_caml).translation().norm();
+    counted = measurement_.addPair(links, extrinsics.leftToRightOptical(), moved);
+  }
+  // Too little parallax since the reference: the next pair is linked to the same one.
+  keeps_reference_ = linked && !counted && measurement_.lastLackedParallax() &&
+                     pairs_on_reference_ < kMostPairsOnOneReference;
+  if (keeps_reference_) {
+    since_reference_ = since_reference;
+    ++pairs_on_reference_;
+    return result;
+  }
+  previous_candidates_.swap(current);
+  since_reference_ = Eigen::Isometry3d::Identity();
+  pairs_on_reference_ = 0;
+  if (!counted) return result;
   const BaselineLength length = measurement_.estimate();
   if (!length.valid) return result;
   forget();

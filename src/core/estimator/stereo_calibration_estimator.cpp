@@ -275,8 +275,10 @@ FrameReport StereoCalibrationEstimator::processFrame(
     if (config_.baseline_from_motion != 0) {
       const BaselineLength length = baseline_restart_.lengthSoFar();
       message << "; measuring the baseline's length from the left camera's motion ("
-              << (length.valid ? "so far " + std::to_string(length.length) + " m" : length.why)
-              << ")";
+              << (length.valid ? "so far " + std::to_string(length.length) + " m" : length.why);
+      if (!baseline_restart_.lastWhy().empty())
+        message << "; the last pair did not count: " << baseline_restart_.lastWhy();
+      message << ")";
     }
     report.events.add(FrameEvent::kNoPointInitialised, message.str());
   }

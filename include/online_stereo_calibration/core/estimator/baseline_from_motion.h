@@ -100,6 +100,10 @@ class BaselineFromMotion {
   /// The length from the pairs so far (valid once config's thresholds are met).
   BaselineLength estimate() const;
   const std::string& lastWhy() const { return last_why_; }
+  /// The last pair did not count because the camera moved too little (min_translation) or
+  /// its motion showed too little parallax (CameraMotionConfig::min_parallax): a pair further
+  /// away may count.
+  bool lastLackedParallax() const { return last_lacked_parallax_; }
   void clear();
 
  private:
@@ -109,6 +113,7 @@ class BaselineFromMotion {
   int inliers_ = 0;
   std::vector<double> pair_lengths_;  ///< each pair's own length
   std::string last_why_;
+  bool last_lacked_parallax_ = false;
 };
 
 }  // namespace osc

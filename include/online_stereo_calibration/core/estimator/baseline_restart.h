@@ -42,13 +42,21 @@ class BaselineRestart {
   void setLinks(std::vector<std::pair<PointMeasurement, PointMeasurement>> links, bool given);
   /// Links are wanted for the next pair: no point could be initialised in the last one.
   bool wantsLinks() const { return !previous_candidates_.empty(); }
+  /// The next pair is linked to the same reference pair as this one was, not to this one:
+  /// the left camera's motion since the reference had too little parallax to count
+  /// (BaselineFromMotion::lastLackedParallax; a MAV at 20 Hz in a room moves 2-3 cm per pair,
+  /// 0.6 px). The front end then keeps its reference pair's matches.
+  bool keepsReference() const { return keeps_reference_; }
   /// Forgets every pair (the points could be initialised, or x_camr changed).
   void forget();
   /// The length so far (for the warning that no point could be initialised).
   BaselineLength lengthSoFar() const { return measurement_.estimate(); }
+  /// Why the last pair measured did not count (empty if it did).
+  const std::string& lastWhy() const { return measurement_.lastWhy(); }
 
-  /// One pair in which no point could be initialised: its candidates are linked to the last
-  /// pair's (by id, or the given links), the left camera's motion between them added, and,
+  /// One pair in which no point could be initialised: its candidates are linked to the
+  /// reference pair's (the last pair's, or an earlier one while keepsReference(); by id, or
+  /// the given links), the left camera's motion between them added, and,
   /// once the length is known well enough and the filter does not know it, the restart of
   /// x_camr's translation returned. @p motion_links_pairs: @p motion is the one since the
   /// last pair (not the first pair after a start or a reset).
@@ -59,8 +67,12 @@ class BaselineRestart {
  private:
   Eigen::Matrix3d K_left_inverse_, K_right_inverse_;
   BaselineFromMotion measurement_;
-  /// The last pair's candidates in normalised coordinates [left (2), right (2)], by id.
+  /// The reference pair's candidates in normalised coordinates [left (2), right (2)], by id.
   std::unordered_map<PointId, Eigen::Vector4d> previous_candidates_;
+  /// The vehicle's motion from the reference pair to the last pair (T_ref_last).
+  Eigen::Isometry3d since_reference_ = Eigen::Isometry3d::Identity();
+  bool keeps_reference_ = false;
+  int pairs_on_reference_ = 0;  ///< pairs linked to the reference so far
   std::vector<std::pair<PointMeasurement, PointMeasurement>> given_links_;
   bool links_given_ = false;
 };

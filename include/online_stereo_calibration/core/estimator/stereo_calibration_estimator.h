@@ -149,6 +149,9 @@ class StereoCalibrationEstimator {
   /// The baseline's length from motion wants linkStereoMatches for the next pair: no point
   /// could be initialised in the last one.
   bool wantsStereoLinks() const { return baseline_restart_.wantsLinks(); }
+  /// The next pair is to be linked to the same earlier pair as this one (the camera has not
+  /// moved enough since it: BaselineRestart::keepsReference), not to this one.
+  bool keepsStereoLinkReference() const { return baseline_restart_.keepsReference(); }
   /// The hand-eye start is still collecting (on, rotation not yet determined).
   bool handEyeActive() const { return config_.hand_eye_start != 0 && !mounting_.done(); }
   /// The hand-eye start's pairs and solver (FilterConfig::hand_eye_start).
