@@ -1,7 +1,8 @@
 /// @file test_stereo_fit_start.cpp
 /// @brief The global stereo fit at start (issue 14): x_camr's rotation from a whole-image fit
 /// in the filter's frames (rightRotationSeed), and at image level (rendered drive, the
-/// CalibrationPipeline) a start with x_camr's angles 5 deg off re-seeded from it.
+/// CalibrationPipeline) a start with x_camr's angles 5 deg off re-seeded from it; starts whose
+/// baseline guess is far off (the length from motion, baseline_restart.h).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "online_stereo_calibration/core/filter/state_layout.h"
@@ -278,6 +280,117 @@ TEST(StereoFitStart, DISABLED_Report) {
                     1e3 * r.last_translation_error, r.last_rotation_error / kDeg);
         std::fflush(stdout);
       }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace osc
+
+namespace osc {
+namespace {
+
+/// An image-level start of the paper drive with the rig's baseline @p truth_length long and
+/// guessed @p guess_length (the seed's other start errors).
+struct BaselineStart {
+  int restarted_at = -1;  ///< the baseline-from-motion restart's pair (-1: none)
+  int started_at = -1;    ///< the first pair from which the filter holds points to the end
+  int frames = 0, within = 0, beyond = 0;  ///< from started_at + 30 on
+  /// Pairs without a point in the filter before the restart, and the whole-image fits the
+  /// knock test made in them (CalibrationPipeline::wholeImageFits).
+  int pairs_without_points = 0, fits_without_points = 0;
+  double worst = 0.0;
+  double length = 0.0, length_sigma = 0.0;  ///< at the end, m
+};
+
+BaselineStart runBaselineStart(double truth_length, double guess_length, int frames,
+                               unsigned seed) {
+  MeasurementScenario scenario = paperOffroadScenario();
+  scenario.seed = seed;
+  scenario.frames = frames;
+  scenario.step_frame = -1;
+  scenario.truth(7) = -truth_length;  // body y: the right camera is to the right
+  scenario.initial_error(7) = truth_length - guess_length;
+  std::vector<ScenarioFrameResult> all;
+  BaselineStart run;
+  runImageScenario(scenario, FilterConfig(), FrontEndConfig(), {},
+                   [&](const ImageFrameResult& r, const CalibrationPipeline& pipeline) {
+                     all.push_back(r.filter);
+                     for (const std::string& w : r.filter.warnings) {
+                       if (w.rfind("baseline length from motion", 0) == 0 && run.restarted_at < 0)
+                         run.restarted_at = r.filter.frame;
+                     }
+                     if (run.restarted_at < 0 && r.filter.tracked_points == 0) {
+                       ++run.pairs_without_points;
+                       run.fits_without_points = pipeline.wholeImageFits();
+                     }
+                   });
+  for (int k = static_cast<int>(all.size()) - 1; k >= 0 && all[k].tracked_points > 0; --k)
+    run.started_at = all[k].frame;
+  for (const ScenarioFrameResult& f : all) {
+    if (run.started_at < 0 || f.frame < run.started_at + 30) continue;
+    const double z = f.tangent_error.cwiseQuotient(f.tangent_sigmas).cwiseAbs().maxCoeff();
+    ++run.frames;
+    run.within += z <= 3.0;
+    run.beyond += z > 5.0;
+    run.worst = std::max(run.worst, z);
+  }
+  run.length = -all.back().parameters(7);
+  run.length_sigma = all.back().sigmas(7);
+  return run;
+}
+
+// Issue "Real drives in": an 11 cm rig guessed at 1 cm. No point passes the depth check with
+// the guess, so the length is measured from the left camera's motion and x_camr restarted at
+// it by pair 50; from 30 pairs after the start all 12 errors within 3 sigma in >= 95 % of the
+// pairs, none beyond 5. (Seeds 1-5: DISABLED_BaselineGuessReport.)
+TEST(BaselineStart, ElevenCentimetreRigGuessedAtOneCentimetreStartsByPair50AndIsHonest) {
+  const BaselineStart run = runBaselineStart(0.11, 0.01, 90, 1);
+  std::cout << "11 cm guessed 1 cm: restarted at " << run.restarted_at << ", started at "
+            << run.started_at << " (" << run.fits_without_points << " whole-image fits in "
+            << run.pairs_without_points << " pairs without points); within 3 sigma in "
+            << run.within << " of " << run.frames << ", worst " << run.worst << "; length "
+            << run.length << " +- " << run.length_sigma << " m\n";
+  EXPECT_GE(run.restarted_at, 0);
+  EXPECT_GE(run.started_at, 0);
+  EXPECT_LE(run.started_at, 50);
+  EXPECT_GE(run.frames, 10);
+  EXPECT_GE(run.within, 0.95 * run.frames);
+  EXPECT_EQ(run.beyond, 0) << "worst " << run.worst;
+  EXPECT_NEAR(run.length, 0.11, 3.0 * run.length_sigma);
+  // Without a point the knock test's whole-image fit ran in one pair of five, not in each
+  // (a pair without points cost 130 ms, one with them 30).
+  EXPECT_GE(run.pairs_without_points, 5);
+  EXPECT_LE(run.fits_without_points, run.pairs_without_points / 5 + 1);
+  EXPECT_GE(run.fits_without_points, 1);
+}
+
+// A 0.3 m rig guessed at 0.6 m: points pass the depth check with the long guess, so the filter
+// starts at once and learns the length from them; honest from pair 30.
+TEST(BaselineStart, ThirtyCentimetreRigGuessedAtSixtyStartsAtOnceAndIsHonest) {
+  const BaselineStart run = runBaselineStart(0.30, 0.60, 70, 1);
+  std::cout << "0.3 m guessed 0.6 m: started at " << run.started_at << "; within 3 sigma in "
+            << run.within << " of " << run.frames << ", worst " << run.worst << "; length "
+            << run.length << " +- " << run.length_sigma << " m\n";
+  EXPECT_EQ(run.restarted_at, -1);
+  EXPECT_EQ(run.started_at, 0);
+  EXPECT_GE(run.within, 0.95 * run.frames);
+  EXPECT_EQ(run.beyond, 0) << "worst " << run.worst;
+  EXPECT_NEAR(run.length, 0.30, 3.0 * run.length_sigma);
+}
+
+// The figures of docs/RESULTS.md "Far-off baseline guesses": both starts over seeds 1-5,
+// 150 pairs. Run with --gtest_also_run_disabled_tests.
+TEST(BaselineStart, DISABLED_BaselineGuessReport) {
+  std::cout << "| rig | guess | seed | restarted at | started at | within 3 sigma from start + 30 "
+               "| max z | length at the end |\n|---|---|---|---|---|---|---|---|\n";
+  for (const auto& [truth, guess] : {std::pair{0.11, 0.01}, std::pair{0.30, 0.60}}) {
+    for (unsigned seed = 1; seed <= 5; ++seed) {
+      const BaselineStart r = runBaselineStart(truth, guess, 150, seed);
+      std::printf("| %.2f m | %.2f m | %u | %d | %d | %d of %d | %.2f | %.4f +- %.4f m |\n", truth,
+                  guess, seed, r.restarted_at, r.started_at, r.within, r.frames, r.worst, r.length,
+                  r.length_sigma);
+      std::fflush(stdout);
     }
   }
 }

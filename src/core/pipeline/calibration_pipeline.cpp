@@ -26,6 +26,9 @@ constexpr int kKnockedPairsBeforeReopening = 2;
 constexpr int kContradictingFitsBeforeReopening = 1;
 /// Stereo pairs (tracked, or matched in the epipolar band) in a pair that count as "none".
 constexpr int kNoPairs = 5;
+/// While the whole-image fits agree with x_camr, one fit in this many pairs without tracked
+/// pairs (CalibrationPipeline::wholeImageFitDue).
+constexpr int kPairsBetweenAgreeingFits = 5;
 
 }  // namespace
 
@@ -105,14 +108,16 @@ PipelineResult CalibrationPipeline::process(const cv::Mat& left, const cv::Mat& 
   double rotation_sigma = 0.0;
   std::string why;
   const bool reopened_by_estimator = result.estimator.has(FrameEvent::kRightCameraOffEpipolarLines);
+  const bool lost = !reopened_by_estimator && lostTheStereoGeometry(result.front_end);
+  if (!lost) pairs_since_whole_image_fit_ = -1;  // the next pair without pairs is fitted at once
   if (reopened_by_estimator) {
     // The estimator's own test of the pairs against the epipolar lines (its warning says how
     // far off they were); it re-opened x_camr already.
     why = "the stereo pairs left x_camr's epipolar lines";
-  } else if (lostTheStereoGeometry(result.front_end)) {
+  } else if (lost) {
     // No pair may mean a knocked camera or merely a view without usable texture (sky, a
     // wall, darkness, blur): only a whole-image fit that contradicts x_camr re-opens it.
-    if (wholeImageFitContradicts(&rotation_sigma, &result.status)) {
+    if (wholeImageFitDue() && wholeImageFitContradicts(&rotation_sigma, &result.status)) {
       why = "no tracked stereo pair, and the whole-image fit contradicts x_camr (" + result.status +
             ")";
     }
@@ -171,6 +176,7 @@ void CalibrationPipeline::linkStereoMatchesToPreviousPair() {
 }
 
 void CalibrationPipeline::keepStereoMatchesForTheNextPair() {
+  if (estimator_->keepsStereoLinkReference()) return;  // the next pair links to the same one
   if (estimator_->wantsStereoLinks()) {
     previous_stereo_matches_ = front_end_->lastStereoMatches();
     previous_stereo_match_descriptors_ = front_end_->lastStereoMatchDescriptors();
@@ -208,6 +214,17 @@ bool CalibrationPipeline::lostTheStereoGeometry(const FrontEndStatistics& stats)
   return textured && none;
 }
 
+bool CalibrationPipeline::wholeImageFitDue() {
+  // After a contradicting fit every pair is fitted until the next one decides.
+  if (fits_contradicting_ > 0 || pairs_since_whole_image_fit_ < 0 ||
+      pairs_since_whole_image_fit_ + 1 >= kPairsBetweenAgreeingFits) {
+    pairs_since_whole_image_fit_ = 0;
+    return true;
+  }
+  ++pairs_since_whole_image_fit_;
+  return false;
+}
+
 bool CalibrationPipeline::rightCameraMoved(double* rotation_sigma) {
   constexpr double kMinDistance = 0.3;  // px: three times a refined pair's own noise
   constexpr double kKnockSigmas = 5.0;
@@ -229,6 +246,7 @@ bool CalibrationPipeline::wholeImageFitContradicts(double* rotation_sigma, std::
   constexpr double kKnockSigmas = 5.0;
   constexpr double kMinAngle = 0.05 * M_PI / 180.0;  // rad: below, not worth a re-opening
   const Eigen::Isometry3d T_lopt_ropt = estimator_->filter().extrinsics().leftToRightOptical();
+  ++whole_image_fits_;
   last_fit_ = fitStereoGeometry(front_end_->lastLeftFeatures(), front_end_->lastRightFeatures(),
                                 estimator_->leftCamera(), estimator_->rightCamera(),
                                 T_lopt_ropt.translation().normalized());
@@ -315,6 +333,7 @@ void CalibrationPipeline::armStereoFit(bool after_reopening) {
 void CalibrationPipeline::restartFrontEnd() {
   front_end_->reset();
   pairs_off_their_lines_ = fits_contradicting_ = 0;
+  pairs_since_whole_image_fit_ = -1;
 }
 
 void CalibrationPipeline::resetTracking() {

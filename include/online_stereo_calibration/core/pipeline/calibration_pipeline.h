@@ -52,7 +52,8 @@ struct PipelineResult {
   bool right_camera_reopened = false;
   /// The whole-image stereo fit at a start was tried in this pair
   /// (FilterConfig::stereo_fit_start); stereo_fit is its seed (valid if the fit was), and
-  /// the estimator's event kRightRotationFromStereoFit says whether x_camr's rotation was re-seeded.
+  /// the estimator's event kRightRotationFromStereoFit says whether x_camr's rotation was
+  /// re-seeded.
   bool stereo_fit_tried = false;
   RightRotationSeed stereo_fit;
   double processing_time = 0.0;  ///< seconds spent on this pair (front end + filter)
@@ -97,6 +98,8 @@ class CalibrationPipeline {
   const StereoCalibrationEstimator& estimator() const;
   /// The front end, for diagnostics and tests (last pair's tracks, matches, windows).
   const StereoFrontEnd& frontEnd() const;
+  /// Whole-image fits made by the knock test so far (wholeImageFitDue), for tests.
+  int wholeImageFits() const { return whole_image_fits_; }
 
  private:
   /// Forgets the front end's tracks and the counts below (the estimator's points are the
@@ -122,6 +125,11 @@ class CalibrationPipeline {
   /// x_camr's; true for such a fit, with 3 times that angle as the rotation sigma to re-open
   /// with. @p status says what was seen.
   bool wholeImageFitContradicts(double* rotation_sigma, std::string* status);
+  /// Whether this pair without tracked pairs gets the whole-image fit (~100 ms on a 1242 px
+  /// pair): the first such pair, then every kPairsBetweenAgreeingFits-th while the fits agree
+  /// with x_camr (a start whose points cannot be initialised, a texture-poor stretch), so that
+  /// a pair without points costs no more than one with them.
+  bool wholeImageFitDue();
   /// Counts pairs whose refined pairs lie off their epipolar lines (EpipolarTrend) by an angle
   /// of more than kKnockSigmas x_camr rotation sigmas; true from the second in a row, with
   /// the rotation sigma that distance calls for.
@@ -133,6 +141,10 @@ class CalibrationPipeline {
   int pairs_off_their_lines_ = 0;
   /// Consecutive whole-image fits contradicting x_camr (wholeImageFitContradicts).
   int fits_contradicting_ = 0;
+  /// Pairs without tracked pairs since the last whole-image fit (wholeImageFitDue); -1: the
+  /// next such pair gets one.
+  int pairs_since_whole_image_fit_ = -1;
+  int whole_image_fits_ = 0;
   GlobalStereoFit last_fit_;
   RightRotationSeed last_seed_;
   /// Pairs left in which the stereo fit at a start is tried (0: none pending).
