@@ -149,9 +149,7 @@ bool CalibrationNodelet::preparePipeline(const StereoPair& pair, const cv::Mat& 
           tf_buffer_
               ->lookupTransform(frames_.left_optical, frames_.right_optical, ros::Time(0), timeout)
               .transform);
-      const Eigen::Isometry3d T_body_opt = osc::bodyFromOptical();
-      guess.T_veh_caml = T_veh_lopt * T_body_opt.inverse();
-      guess.T_caml_camr = T_body_opt * T_lopt_ropt * T_body_opt.inverse();
+      guess = osc::StereoExtrinsics::fromOpticalFrames(T_veh_lopt, T_lopt_ropt);
     } catch (const std::exception& e) {
       diagnostics_->recordProblem("no initial guess", e.what());
       NODELET_ERROR_THROTTLE(5.0, "online_stereo_calibration: initial guess from tf: %s", e.what());

@@ -50,7 +50,6 @@ class FrameEvents {
     return false;
   }
   bool empty() const { return lines_.empty(); }
-  size_t size() const { return lines_.size(); }
   std::vector<FrameEventLine>::const_iterator begin() const { return lines_.begin(); }
   std::vector<FrameEventLine>::const_iterator end() const { return lines_.end(); }
   /// Every line's text, in order.
