@@ -138,4 +138,44 @@ TEST_F(KittiRawTools, TheBagOfTheFolderEvaluatesAsTheFolder) {
   EXPECT_EQ(readText(dir_.file("folder/reference.csv")), readText(dir_.file("bag/reference.csv")));
 }
 
+// scripts/information_by_motion.py on a made-up drive of three pairs: the second pitches at
+// 10 deg/s and is where zl's sigma shrinks, the third drives straight and shrinks xl's. Each
+// parameter's information is put in the class of the pair that gained it, and a parameter
+// that gained nothing has no share.
+TEST(InformationByMotion, PutsEachPairsGainInTheClassOfItsMotion) {
+  osc::TempDir dir("information_by_motion");
+  const std::string drive = dir.file("drive");
+  ASSERT_EQ(std::system(("mkdir -p " + drive + "/oxts/data").c_str()), 0);
+  std::ofstream stamps(drive + "/oxts/timestamps.txt");
+  const double pitch_rates[3] = {0.0, 10.0 * M_PI / 180.0, 0.0};  // rad/s
+  for (int k = 0; k < 3; ++k) {
+    stamps << "1970-01-01 00:00:10." << k << "00000000\n";
+    std::ofstream record(drive + "/oxts/data/000000000" + std::to_string(k) + ".txt");
+    for (int field = 0; field < 30; ++field)
+      record << (field == 21 ? pitch_rates[k] : field == 8 ? 8.0 : 0.0) << " ";
+  }
+  stamps.close();
+  std::ofstream estimates(dir.file("estimates.csv"));
+  estimates << "frame,stamp,sigma_xl,sigma_yl,sigma_zl,sigma_roll_l,sigma_pitch_l,sigma_yaw_l\n"
+            << "0,10.0,1,1,1,1,1,1\n1,10.1,1,1,0.5,1,1,1\n2,10.2,0.5,1,0.5,1,1,1\n";
+  estimates.close();
+  const std::string script = std::string(OSC_SOURCE_DIR) + "/scripts/information_by_motion.py";
+  ASSERT_EQ(run("/usr/bin/python3 " + script, dir.file("estimates.csv") + " " + drive,
+                dir.file("out.txt")),
+            0)
+      << readText(dir.file("out.txt"));
+  const std::string out = readText(dir.file("out.txt"));
+  EXPECT_NE(out.find("| xl | 0 % | 0 % | 100 % |"), std::string::npos) << out;
+  EXPECT_NE(out.find("| zl | 0 % | 100 % | 0 % |"), std::string::npos) << out;
+  EXPECT_NE(out.find("| yl | - | - | - |"), std::string::npos) << out;
+  EXPECT_NE(out.find("pair 1: speed 8.0 m/s, roll/pitch/yaw rate 0.0/10.0/0.0 deg/s"),
+            std::string::npos)
+      << out;
+  // A missing estimates file is named.
+  EXPECT_NE(run("/usr/bin/python3 " + script, dir.file("none.csv") + " " + drive,
+                dir.file("missing.txt")),
+            0);
+  EXPECT_NE(readText(dir.file("missing.txt")).find("none.csv not found"), std::string::npos);
+}
+
 }  // namespace
