@@ -2,8 +2,12 @@
 """Where a KITTI raw drive's information on x_caml comes from, by the vehicle's motion.
 
     scripts/information_by_motion.py ESTIMATES.csv KITTI_RAW_DIR [--threshold-dps 3]
+        [--stamp-offset S]
 
-ESTIMATES.csv is `evaluate --kitti-raw KITTI_RAW_DIR ... --out OUT`'s OUT/estimates.csv. Each
+ESTIMATES.csv is `evaluate --kitti-raw KITTI_RAW_DIR ... --out OUT`'s OUT/estimates.csv, or
+that of a simulated drive of the same motion (`kitti_raw_to_bag --tum`, a scenario with that
+trajectory, `simulate`, `evaluate`) with --stamp-offset = its first pair's time in the drive's
+clock minus its own first stamp. Each
 pair's information gain on a parameter is how much 1/sigma^2 grew over the pair (the marginal
 sigma: a first look, blind to correlations, and net of the drift noise the prediction added).
 The pair is put in one class by the OXTS record nearest its stamp: "turning" (|yaw rate| above
@@ -77,6 +81,8 @@ def main():
     parser.add_argument("drive")
     parser.add_argument("--threshold-dps", type=float, default=3.0,
                         help="rotation rate (deg/s) above which a pair is turning or pitching")
+    parser.add_argument("--stamp-offset", type=float, default=0.0,
+                        help="s added to the estimates' stamps before the OXTS lookup")
     args = parser.parse_args()
     if not os.path.isfile(args.estimates):
         sys.exit(f"information_by_motion.py: {args.estimates} not found (evaluate's estimates.csv)")
@@ -92,7 +98,7 @@ def main():
     gain = {p: {c: 0.0 for c in CLASSES} for p in PARAMETERS}
     largest = {p: [] for p in PARAMETERS}
     for before, row in zip(rows, rows[1:]):
-        record = records[stamps[nearest(stamps, float(row["stamp"]))]]
+        record = records[stamps[nearest(stamps, float(row["stamp"]) + args.stamp_offset)]]
         kind = classify(record, args.threshold_dps)
         pairs[kind] += 1
         for p in PARAMETERS:

@@ -24,6 +24,7 @@
 #include <opencv2/core.hpp>
 #include "temp_dir.h"
 
+#include "online_stereo_calibration/core/geometry/rotation.h"
 #include "online_stereo_calibration/core/sim/measurement_simulator.h"
 #include "online_stereo_calibration/tools/calibration_file.h"
 #include "online_stereo_calibration/tools/command_line.h"
@@ -32,6 +33,7 @@
 #include "online_stereo_calibration/tools/estimator_config_yaml.h"
 #include "online_stereo_calibration/tools/evaluation.h"
 #include "online_stereo_calibration/tools/filter_config_yaml.h"
+#include "online_stereo_calibration/tools/output_directory.h"
 #include "online_stereo_calibration/tools/scenario_file.h"
 #include "online_stereo_calibration/tools/tum_trajectory.h"
 
@@ -1201,6 +1203,32 @@ TEST(ScenarioFileCampaignKeys, TumTrajectoryBecomesTheMeasurementSimulatorsDrive
                           dir.path())
                 .find("motion.stops"),
             std::string::npos);
+}
+
+// formatTumTrajectory writes what readTumTrajectory reads back: the stamps to the nanosecond
+// at KITTI's ~1.3e9 s, positions to 0.1 mm, rotations to ~1e-9 rad; the comment as '#' lines.
+TEST(TumTrajectory, FormattedPosesAreReadBack) {
+  std::vector<StampedPose> poses;
+  for (int k = 0; k < 5; ++k) {
+    StampedPose p;
+    p.stamp = 1317045935.706851006 + 0.0103 * k;
+    p.pose.linear() = expSO3(Eigen::Vector3d(0.01 * k, -0.2, 1.0 + 0.3 * k));
+    p.pose.translation() = Eigen::Vector3d(1234.5678 + k, -0.25 * k, 3.0);
+    poses.push_back(p);
+  }
+  const std::string text = formatTumTrajectory(poses, "first line\nsecond line");
+  EXPECT_EQ(text.rfind("# first line\n# second line\n", 0), 0u) << text;
+  TempDir dir;
+  const std::string path = dir.path() + "/poses.tum";
+  writeTextFileAtomic(path, text);
+  const PoseTrajectory back = readTumTrajectory(path);
+  ASSERT_EQ(back.size(), poses.size());
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_NEAR(back.poses()[k].stamp, poses[k].stamp, 1e-6) << k;
+    EXPECT_LT((back.poses()[k].pose.translation() - poses[k].pose.translation()).norm(), 1e-4);
+    EXPECT_LT(logSO3(back.poses()[k].pose.linear().transpose() * poses[k].pose.linear()).norm(),
+              1e-8);
+  }
 }
 
 TEST(ScenarioFileCampaignKeys, RealRecordedTrajectoryDrivesTheMeasurementSimulator) {

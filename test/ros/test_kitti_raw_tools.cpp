@@ -141,7 +141,7 @@ TEST_F(KittiRawTools, TheBagOfTheFolderEvaluatesAsTheFolder) {
 // scripts/information_by_motion.py on a made-up drive of three pairs: the second pitches at
 // 10 deg/s and is where zl's sigma shrinks, the third drives straight and shrinks xl's. Each
 // parameter's information is put in the class of the pair that gained it, and a parameter
-// that gained nothing has no share.
+// that gained nothing has no share; estimates on another clock are matched with an offset.
 TEST(InformationByMotion, PutsEachPairsGainInTheClassOfItsMotion) {
   osc::TempDir dir("information_by_motion");
   const std::string drive = dir.file("drive");
@@ -171,6 +171,16 @@ TEST(InformationByMotion, PutsEachPairsGainInTheClassOfItsMotion) {
   EXPECT_NE(out.find("pair 1: speed 8.0 m/s, roll/pitch/yaw rate 0.0/10.0/0.0 deg/s"),
             std::string::npos)
       << out;
+  // A simulated drive's clock: its stamps 5 s later, --stamp-offset -5 finds the same records.
+  std::ofstream shifted(dir.file("shifted.csv"));
+  shifted << "frame,stamp,sigma_xl,sigma_yl,sigma_zl,sigma_roll_l,sigma_pitch_l,sigma_yaw_l\n"
+          << "0,15.0,1,1,1,1,1,1\n1,15.1,1,1,0.5,1,1,1\n2,15.2,0.5,1,0.5,1,1,1\n";
+  shifted.close();
+  ASSERT_EQ(
+      run("/usr/bin/python3 " + script,
+          dir.file("shifted.csv") + " " + drive + " --stamp-offset=-5", dir.file("shifted.txt")),
+      0);
+  EXPECT_EQ(readText(dir.file("shifted.txt")), out);
   // A missing estimates file is named.
   EXPECT_NE(run("/usr/bin/python3 " + script, dir.file("none.csv") + " " + drive,
                 dir.file("missing.txt")),

@@ -1,8 +1,9 @@
 /// @file tum_trajectory.cpp
-/// @brief Reader of TUM trajectory files (see tum_trajectory.h).
+/// @brief Reader and writer of TUM trajectory files (see tum_trajectory.h).
 #include "online_stereo_calibration/tools/tum_trajectory.h"
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -45,6 +46,22 @@ PoseTrajectory readTumTrajectory(const std::string& path) {
   }
   if (trajectory.size() < 2) throw std::runtime_error(path + ": fewer than 2 poses");
   return trajectory;
+}
+
+std::string formatTumTrajectory(const std::vector<StampedPose>& poses, const std::string& comment) {
+  std::ostringstream out;
+  std::istringstream lines(comment);
+  std::string line;
+  while (std::getline(lines, line)) out << "# " << line << "\n";
+  for (const StampedPose& p : poses) {
+    const Eigen::Quaterniond q(p.pose.linear());
+    const Eigen::Vector3d& t = p.pose.translation();
+    char text[256];
+    std::snprintf(text, sizeof text, "%.9f %.4f %.4f %.4f %.9f %.9f %.9f %.9f\n", p.stamp, t.x(),
+                  t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+    out << text;
+  }
+  return out.str();
 }
 
 }  // namespace osc

@@ -30,11 +30,12 @@
 #include "online_stereo_calibration/tools/kitti_raw_drive.h"
 #include "online_stereo_calibration/tools/kitti_raw_source.h"
 #include "online_stereo_calibration/tools/output_directory.h"
+#include "online_stereo_calibration/tools/tum_trajectory.h"
 
 namespace {
 
 struct Options {
-  std::string kitti_raw, out;
+  std::string kitti_raw, out, tum;
   int frames = -1;
   osc::KittiRawCommandLine reader;
 };
@@ -46,7 +47,10 @@ osc::CommandLine commandLine(Options* o) {
       "interface's\ntopics: stereo images and camera_info, /odom from the OXTS records, KITTI's "
       "calibration on\n/ground_truth/calibration.");
   cli.option("--kitti-raw", &o->kitti_raw, "DIR", "KITTI raw drive folder").required();
-  cli.option("--out", &o->out, "OUT.bag", "bag to write").required();
+  cli.option("--out", &o->out, "OUT.bag", "bag to write (or only --tum)");
+  cli.option("--tum", &o->tum, "OUT.tum",
+             "also write the OXTS poses (the vehicle = IMU frame in KITTI's world, at the records' "
+             "stamps)\nas a TUM trajectory, e.g. for a simulated drive of the same motion");
   cli.option("--frames", &o->frames, "N", "write only the first N usable frames")
       .range(1, 1e9)
       .defaultText("all");
@@ -75,6 +79,18 @@ int convert(const Options& options) {
       osc::readKittiRawDrive(options.kitti_raw, options.reader.options());
   std::cerr << "converting " << drive.summary();
   for (const std::string& line : drive.skippedLines()) std::cerr << "  skipped " << line << "\n";
+  if (!options.tum.empty()) {
+    osc::makeDirectories(osc::directoryOf(options.tum));
+    osc::writeTextFileAtomic(
+        options.tum,
+        osc::formatTumTrajectory(
+            drive.imu_poses.poses(),
+            "KITTI raw " + options.kitti_raw + ": the OXTS poses (kitti_raw_to_bag --tum)\n" +
+                "vehicle frame = the OXTS/IMU frame (x forward, y left, z up); world x east, y "
+                "north, z up"));
+    std::cerr << "wrote " << options.tum << ": " << drive.imu_poses.size() << " poses\n";
+  }
+  if (options.out.empty()) return 0;
   std::size_t frames = drive.frames.size();
   if (options.frames > 0) frames = std::min(frames, static_cast<std::size_t>(options.frames));
 
@@ -147,6 +163,9 @@ int main(int argc, char** argv) {
       "kitti_raw_to_bag", [&] { return cli.usage(); },
       [&] {
         if (!cli.parse(argc, argv)) return 0;
+        if (parsed.out.empty() && parsed.tum.empty()) {
+          throw osc::CommandLineError("give --out OUT.bag, --tum OUT.tum or both");
+        }
         return convert(parsed);
       });
 }
