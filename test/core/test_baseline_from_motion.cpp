@@ -255,7 +255,7 @@ TEST(BaselineRestart, ASlowCameraIsLinkedToAnEarlierPairUntilItHasMovedEnough) {
     kept += restart.keepsReference();
     if (reseed.reseed) reseeded_at = k;
   }
-  ASSERT_GE(reseeded_at, 0) << restart.lengthSoFar().why << "; " << restart.lastWhy();
+  ASSERT_GE(reseeded_at, 0) << restart.progress();
   EXPECT_GE(kept, 5 * 2);  // five pairs counted, each after at least two kept
   EXPECT_NEAR(reseed.T_caml_camr.translation().norm(), 0.3, 0.03);
 }

@@ -50,8 +50,15 @@ void BaselineRestart::forget() {
   given_links_.clear();
   links_given_ = false;
   since_reference_ = Eigen::Isometry3d::Identity();
-  keeps_reference_ = false;
   pairs_on_reference_ = 0;
+}
+
+std::string BaselineRestart::progress() const {
+  const BaselineLength length = measurement_.estimate();
+  std::string text = length.valid ? "so far " + std::to_string(length.length) + " m" : length.why;
+  if (!measurement_.lastWhy().empty())
+    text += "; the last pair did not count: " + measurement_.lastWhy();
+  return text;
 }
 
 BaselineReseed BaselineRestart::afterPair(const MotionIncrement& motion, bool motion_links_pairs,
@@ -88,9 +95,8 @@ BaselineReseed BaselineRestart::afterPair(const MotionIncrement& motion, bool mo
     counted = measurement_.addPair(links, extrinsics.leftToRightOptical(), moved);
   }
   // Too little parallax since the reference: the next pair is linked to the same one.
-  keeps_reference_ = linked && !counted && measurement_.lastLackedParallax() &&
-                     pairs_on_reference_ < kMostPairsOnOneReference;
-  if (keeps_reference_) {
+  if (linked && !counted && measurement_.lastLackedParallax() &&
+      pairs_on_reference_ < kMostPairsOnOneReference) {
     since_reference_ = since_reference;
     ++pairs_on_reference_;
     return result;

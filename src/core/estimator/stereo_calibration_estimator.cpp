@@ -273,12 +273,8 @@ FrameReport StereoCalibrationEstimator::processFrame(
             << "(baseline yr " << e.parameters(7) << " m, 1 sigma " << e.sigmas()(7)
             << " m); check the baseline guess and initial_camr_translation_sigma_m";
     if (config_.baseline_from_motion != 0) {
-      const BaselineLength length = baseline_restart_.lengthSoFar();
       message << "; measuring the baseline's length from the left camera's motion ("
-              << (length.valid ? "so far " + std::to_string(length.length) + " m" : length.why);
-      if (!baseline_restart_.lastWhy().empty())
-        message << "; the last pair did not count: " << baseline_restart_.lastWhy();
-      message << ")";
+              << baseline_restart_.progress() << ")";
     }
     report.events.add(FrameEvent::kNoPointInitialised, message.str());
   }

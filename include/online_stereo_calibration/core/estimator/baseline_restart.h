@@ -46,13 +46,12 @@ class BaselineRestart {
   /// the left camera's motion since the reference had too little parallax to count
   /// (BaselineFromMotion::lastLackedParallax; a MAV at 20 Hz in a room moves 2-3 cm per pair,
   /// 0.6 px). The front end then keeps its reference pair's matches.
-  bool keepsReference() const { return keeps_reference_; }
+  bool keepsReference() const { return pairs_on_reference_ > 0; }
   /// Forgets every pair (the points could be initialised, or x_camr changed).
   void forget();
-  /// The length so far (for the warning that no point could be initialised).
-  BaselineLength lengthSoFar() const { return measurement_.estimate(); }
-  /// Why the last pair measured did not count (empty if it did).
-  const std::string& lastWhy() const { return measurement_.lastWhy(); }
+  /// The measurement so far, for the warning that no point could be initialised: the length
+  /// (or why there is none yet) and why the last pair did not count, if it did not.
+  std::string progress() const;
 
   /// One pair in which no point could be initialised: its candidates are linked to the
   /// reference pair's (the last pair's, or an earlier one while keepsReference(); by id, or
@@ -71,8 +70,9 @@ class BaselineRestart {
   std::unordered_map<PointId, Eigen::Vector4d> previous_candidates_;
   /// The vehicle's motion from the reference pair to the last pair (T_ref_last).
   Eigen::Isometry3d since_reference_ = Eigen::Isometry3d::Identity();
-  bool keeps_reference_ = false;
-  int pairs_on_reference_ = 0;  ///< pairs linked to the reference so far
+  /// Pairs linked to the reference so far while its parallax was too small (0: the next pair
+  /// is linked to the last one).
+  int pairs_on_reference_ = 0;
   std::vector<std::pair<PointMeasurement, PointMeasurement>> given_links_;
   bool links_given_ = false;
 };
