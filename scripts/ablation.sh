@@ -89,10 +89,13 @@ bench() {
   mkdir -p "$dir"
   local with_config=()
   [[ -n "$config" ]] && with_config=(--config "$config")
-  "$bin/campaign" --runs "$runs" --jobs "$jobs" --seed "$seed" --ranges "$out/drawn.yaml" \
-    "${with_config[@]}" --out "$dir/drawn" > "$dir/drawn.log" 2>&1
-  "$bin/campaign" --runs "$runs" --jobs "$jobs" --seed "$seed" --ranges "$out/phase0.yaml" \
-    "${with_config[@]}" --out "$dir/phase0" > "$dir/phase0.log" 2>&1
+  # A campaign that finished (its summary written) is kept: an interrupted ablation resumes.
+  local campaign
+  for campaign in drawn phase0; do
+    [[ -f "$dir/$campaign/summary.txt" ]] ||
+      "$bin/campaign" --runs "$runs" --jobs "$jobs" --seed "$seed" --ranges "$out/$campaign.yaml" \
+        "${with_config[@]}" --out "$dir/$campaign" > "$dir/$campaign.log" 2>&1
+  done
   # paper_offroad seeds 1-27; the noise bench draws 28-54.
   local first=1
   [[ "$seed" == 1 ]] || first=28
