@@ -291,6 +291,11 @@ void CalibrationDiagnostics::produceStatus(diagnostic_updater::DiagnosticStatusW
             " (camera clock minus odometry clock: the odometry stamped t holds the vehicle at "
             "camera time t + offset; 1 sigma)");
   }
+  // The odometry's noise as learned (odometry_noise_matcher.h), when it is learned.
+  if (have_estimate_ && estimate_.odometry_noise.enabled) {
+    const std::string learned = estimate_.odometry_noise.message();
+    status.add("odometry noise", learned.empty() ? "as configured" : learned);
+  }
   // x_camr's drift rate (issue 15), when it is estimated.
   if (have_estimate_ && estimate_.camr_drift_rate_sigma.maxCoeff() > 0.0) {
     constexpr double kDegPerMin = 60.0 * 180.0 / M_PI;

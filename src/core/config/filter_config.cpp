@@ -263,6 +263,10 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            kOdometryModel, kUser,
            "1 sigma of the odometry's scale error, which images cannot tell: added to the "
            "reported uncertainty of the translations (0 = the odometry's scale is exact)"),
+      real("odometry_noise_window_s", &C::odometry_noise_window, 1.0, 0.0, 1e4, kOdometryModel,
+           kUser,
+           "window over which the odometry's noise is learned from the innovations: the "
+           "configured motion noise is raised when the data show more (0 = used as configured)"),
       real("camr_rotation_drift_rate_sigma_deg_per_min", &C::camr_rotation_drift_rate_sigma,
            kDeg / 60.0, 0.0, 1e4, kRigAndNoise, kUser,
            "steady-state 1 sigma per axis of the rate at which the left->right rotation drifts "

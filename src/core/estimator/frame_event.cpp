@@ -32,6 +32,8 @@ const char* frameEventName(FrameEvent kind) {
       return "no point measurable";
     case FrameEvent::kCovarianceRepaired:
       return "covariance repaired";
+    case FrameEvent::kOdometryNoiseLearned:
+      return "odometry noise learned";
   }
   return "unknown event";
 }

@@ -53,7 +53,8 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
       guess_(initial_guess),
       mounting_(left_, handEyeConfig(config)),
       baseline_restart_(config, left_.K(), right_.K()),
-      monitor_(config) {
+      monitor_(config),
+      noise_matcher_(OdometryNoiseMatcherOptions::from(config)) {
   filter_.reset(initial_guess);
   followFilter();
   guess_covariance_ = filter_.covariance();
@@ -77,6 +78,18 @@ void StereoCalibrationEstimator::setFilterDriftInflation() {
   // step predicts with them, and the step reuses that prediction.
   filter_.setDriftInflation({monitor_.inflation(ConsistencyBlock::kVehicleToLeft),
                              monitor_.inflation(ConsistencyBlock::kLeftToRight)});
+}
+
+void StereoCalibrationEstimator::learnOdometryNoise(const MotionIncrement& motion,
+                                                    FrameReport* report) {
+  const std::string before = noise_matcher_.status().message();
+  noise_matcher_.addUpdate(motion.dt, filter_.lastMotionNoiseEvidence());
+  filter_.setMotionNoiseFactors(noise_matcher_.factors());
+  const std::string after = noise_matcher_.status().message();
+  if (before.empty() != after.empty()) {
+    report->events.add(FrameEvent::kOdometryNoiseLearned,
+                       after.empty() ? "odometry noise as configured again" : after);
+  }
 }
 
 bool StereoCalibrationEstimator::restartIfLinearizedFarOff(FrameReport* report) {
@@ -208,6 +221,7 @@ FrameReport StereoCalibrationEstimator::processFrame(
       monitor_.addUpdate(motion.dt, filter_.lastUpdateScores());
       report.consistency = monitor_.status();
       setFilterDriftInflation();
+      learnOdometryNoise(motion, &report);
     }
     if (!report.step.accepted) {
       // Without a usable motion the points cannot be predicted: start tracking afresh.
@@ -435,6 +449,8 @@ void StereoCalibrationEstimator::forgetDriveEvidence() {
   knock_test_.reset();
   mounting_.clear();
   gap_check_.reset();
+  noise_matcher_.reset();
+  filter_.setMotionNoiseFactors(noise_matcher_.factors());
 }
 
 void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess) {
@@ -490,6 +506,7 @@ CalibrationEstimate StereoCalibrationEstimator::estimate() const {
   e.tracked_points = filter_.pointCount();
   e.excitation = filter_.excitationGains();
   e.consistency = monitor_.status();
+  e.odometry_noise = noise_matcher_.status();
   e.time_offset = filter_.timeOffset();
   e.time_offset_sigma = filter_.timeOffsetSigma();
   e.camr_drift_rate = filter_.camrDriftRate();

@@ -229,6 +229,7 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
                                 Vector6d* motion_error) {
   StepReport& report = *out;
   has_scores_ = false;
+  has_motion_evidence_ = false;
   // ---- prediction (Sec. II-B) ----
   const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
   std::vector<bool> remove;
@@ -316,7 +317,8 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   // the calibration drifts. Fed to the consistency monitor they raised x_camr's process
   // noise for tens of seconds (x_camr RMSE +15-30 % over the default campaign).
   const bool monitored =
-      final_pass && config_.consistency_window > 0.0 && !used.empty() && tempering == 1.0;
+      final_pass && (config_.consistency_window > 0.0 || config_.odometry_noise_window > 0.0) &&
+      !used.empty() && tempering == 1.0;
   const VectorXd dg_prior = dg;
   MatrixXd information = monitored ? MatrixXd::Zero(G, G) : MatrixXd();
   VectorXd score = monitored ? VectorXd::Zero(G) : VectorXd();
@@ -343,6 +345,11 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
     scores_ = computeUpdateScores(information, score, residual_norm, P,
                                   layout::kMeasurementDim * static_cast<int>(used.size()));
     has_scores_ = true;
+    if (shared) {
+      motion_evidence_ = motionNoiseEvidence(globalScore(information, score, P),
+                                             configuredMotionNoise(motion), motion_noise_factors_);
+      has_motion_evidence_ = true;
+    }
   }
   *motion_error = shared ? Vector6d(dg.tail<6>()) : Vector6d::Zero();
   if (!final_pass) return true;

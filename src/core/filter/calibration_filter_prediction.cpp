@@ -248,6 +248,10 @@ MatrixXd CalibrationFilter::predict(const MotionIncrement& motion, std::vector<b
   return P;
 }
 
+Matrix6d CalibrationFilter::configuredMotionNoise(const MotionIncrement& motion) const {
+  return motion.has_covariance ? motion.covariance : motionNoiseCovariance(config_, motion.dt);
+}
+
 MatrixXd CalibrationFilter::predictAnew(const MotionIncrement& motion, std::vector<bool>* failed) {
   applyCalibrationDrift(motion.dt);
   const bool shared = config_.motion_noise_model == MotionNoiseModel::kShared;
@@ -255,9 +259,12 @@ MatrixXd CalibrationFilter::predictAnew(const MotionIncrement& motion, std::vect
   MatrixXd P = MatrixXd::Zero(G, G);
   P.topLeftCorner(persistentDim(), persistentDim()) = covariance_;
   if (shared) {
-    // The odometry's own covariance of this increment when it gives one, else the model.
+    // Times what the odometry noise matcher learned, per part (translation, rotation).
+    Eigen::Matrix<double, 6, 1> scale;
+    scale << Eigen::Vector3d::Constant(std::sqrt(motion_noise_factors_[0])),
+        Eigen::Vector3d::Constant(std::sqrt(motion_noise_factors_[1]));
     P.bottomRightCorner<6, 6>() =
-        motion.has_covariance ? motion.covariance : motionNoiseCovariance(config_, motion.dt);
+        scale.asDiagonal() * configuredMotionNoise(motion) * scale.asDiagonal();
     // ... plus what the first-order time-offset correction leaves out (process_model.h).
     const double offset_variance =
         time_offset_index_ >= 0 ? covariance_(time_offset_index_, time_offset_index_) : 0.0;

@@ -4,86 +4,9 @@
 #include <cmath>
 #include <vector>
 
-#include <Eigen/Eigenvalues>
-
 #include "online_stereo_calibration/core/filter/state_layout.h"
 
 namespace osc {
-namespace {
-
-/// Upper standard normal quantile: P(Z > z) = probability, by bisection on erfc.
-double normalUpperQuantile(double probability) {
-  double lo = -40.0, hi = 40.0;
-  for (int k = 0; k < 200; ++k) {
-    const double mid = 0.5 * (lo + hi);
-    if (0.5 * std::erfc(mid / M_SQRT2) > probability) {
-      lo = mid;
-    } else {
-      hi = mid;
-    }
-  }
-  return 0.5 * (lo + hi);
-}
-
-/// A symmetric PSD F scaled to unit diagonal, D F D with D = diag(1 / sqrt(F_aa)) (0 where
-/// F_aa <= 0): the blocks mix metres and radians. Its eigenvalues at or below 1e-9 of the
-/// largest count as zero: directions the update carries (relatively) no information on.
-struct ScaledEigen {
-  explicit ScaledEigen(const Eigen::MatrixXd& F) : scale(F.diagonal().cwiseMax(0.0).cwiseSqrt()) {
-    for (int a = 0; a < scale.size(); ++a) scale(a) = scale(a) > 0.0 ? 1.0 / scale(a) : 0.0;
-    eigen.compute(scale.asDiagonal() * F * scale.asDiagonal());
-    largest = eigen.eigenvalues().maxCoeff();
-  }
-  bool informative(int k) const { return largest > 0.0 && eigen.eigenvalues()(k) > 1e-9 * largest; }
-
-  Eigen::VectorXd scale;  ///< D's diagonal
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen;
-  double largest = 0.0;
-};
-
-/// g_S^T F_SS^+ g_S over the index set S, and the rank of F_SS (ScaledEigen's tolerance).
-double quadraticForm(const Eigen::MatrixXd& F, const Eigen::VectorXd& g,
-                     const std::vector<int>& indices, int* rank) {
-  const int n = static_cast<int>(indices.size());
-  Eigen::MatrixXd F_s(n, n);
-  Eigen::VectorXd g_s(n);
-  for (int a = 0; a < n; ++a) {
-    g_s(a) = g(indices[a]);
-    for (int b = 0; b < n; ++b) F_s(a, b) = F(indices[a], indices[b]);
-  }
-  const ScaledEigen scaled(F_s);
-  g_s = scaled.scale.asDiagonal() * g_s;
-  double value = 0.0;
-  *rank = 0;
-  for (int k = 0; k < n; ++k) {
-    if (!scaled.informative(k)) continue;
-    const double projection = scaled.eigen.eigenvectors().col(k).dot(g_s);
-    value += projection * projection / scaled.eigen.eigenvalues()(k);
-    ++*rank;
-  }
-  return value;
-}
-
-std::vector<int> indexRange(int first, int count) {
-  std::vector<int> r(count);
-  for (int k = 0; k < count; ++k) r[k] = first + k;
-  return r;
-}
-
-/// The pseudo-inverse of a symmetric PSD F with ScaledEigen's scaling and rank tolerance.
-Eigen::MatrixXd pseudoInverse(const Eigen::MatrixXd& F) {
-  const ScaledEigen scaled(F);
-  const int n = static_cast<int>(F.rows());
-  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(n);
-  for (int k = 0; k < n; ++k) {
-    if (scaled.informative(k)) inverse(k) = 1.0 / scaled.eigen.eigenvalues()(k);
-  }
-  const Eigen::MatrixXd& V = scaled.eigen.eigenvectors();
-  return scaled.scale.asDiagonal() * (V * inverse.asDiagonal() * V.transpose()) *
-         scaled.scale.asDiagonal();
-}
-
-}  // namespace
 
 Eigen::Matrix<double, 6, 1> partialShiftEstimate(const Eigen::Matrix<double, 12, 1>& g,
                                                  const Eigen::Matrix<double, 12, 12>& F,
@@ -91,10 +14,10 @@ Eigen::Matrix<double, 6, 1> partialShiftEstimate(const Eigen::Matrix<double, 12,
   const int b = block == ConsistencyBlock::kVehicleToLeft ? layout::kCaml : layout::kCamr;
   const int o = block == ConsistencyBlock::kVehicleToLeft ? layout::kCamr : layout::kCaml;
   const Eigen::MatrixXd F_bo = F.block<6, 6>(b, o);
-  const Eigen::MatrixXd regression = F_bo * pseudoInverse(F.block<6, 6>(o, o));
+  const Eigen::MatrixXd regression = F_bo * scaledPseudoInverse(F.block<6, 6>(o, o));
   const Eigen::MatrixXd F_partial = F.block<6, 6>(b, b) - regression * F_bo.transpose();
   const Eigen::VectorXd g_partial = g.segment<6>(b) - regression * g.segment<6>(o);
-  return pseudoInverse(0.5 * (F_partial + F_partial.transpose())) * g_partial;
+  return scaledPseudoInverse(0.5 * (F_partial + F_partial.transpose())) * g_partial;
 }
 
 const char* consistencyBlockName(ConsistencyBlock block) {
@@ -125,14 +48,6 @@ std::string ConsistencyStatus::message() const {
   return "";
 }
 
-double chiSquareUpperQuantile(double dof, double probability) {
-  if (!(dof > 0.0)) return 0.0;
-  // Wilson-Hilferty: (X / k)^(1/3) is close to normal with mean 1 - 2/(9k), var 2/(9k).
-  const double v = 2.0 / (9.0 * dof);
-  const double root = 1.0 - v + normalUpperQuantile(probability) * std::sqrt(v);
-  return dof * std::max(root, 0.0) * root * root;
-}
-
 void calibrationStatistics(const Eigen::Matrix<double, 12, 1>& g,
                            const Eigen::Matrix<double, 12, 12>& F, std::array<double, 2>* statistic,
                            std::array<int, 2>* dof) {
@@ -140,36 +55,15 @@ void calibrationStatistics(const Eigen::Matrix<double, 12, 1>& g,
   const Eigen::MatrixXd Fd = F;
   int rank_caml = 0, rank_camr = 0, rank_both = 0;
   const double t_caml =
-      quadraticForm(Fd, gd, indexRange(layout::kCaml, layout::kPoseDim), &rank_caml);
+      scoreStatistic(Fd, gd, indexRange(layout::kCaml, layout::kPoseDim), &rank_caml);
   const double t_camr =
-      quadraticForm(Fd, gd, indexRange(layout::kCamr, layout::kPoseDim), &rank_camr);
-  const double t_both = quadraticForm(Fd, gd, indexRange(0, layout::kCalibrationDim), &rank_both);
+      scoreStatistic(Fd, gd, indexRange(layout::kCamr, layout::kPoseDim), &rank_camr);
+  const double t_both = scoreStatistic(Fd, gd, indexRange(0, layout::kCalibrationDim), &rank_both);
   // Partial scores: each block with the other one free, T_{b|o} = T_{b+o} - T_o.
   (*statistic)[0] = std::max(t_both - t_camr, 0.0);
   (*dof)[0] = std::max(rank_both - rank_camr, 0);
   (*statistic)[1] = std::max(t_both - t_caml, 0.0);
   (*dof)[1] = std::max(rank_both - rank_caml, 0);
-}
-
-UpdateScores computeUpdateScores(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
-                                 double residual_norm, const Eigen::MatrixXd& P_post,
-                                 int measurement_dof) {
-  UpdateScores scores;
-  const int G = static_cast<int>(A.rows());
-  // Score and its covariance of a shift of the global error beyond its prior.
-  const Eigen::VectorXd correction = P_post * b;  // the update's correction of the mean
-  const Eigen::VectorXd g = b - A * correction;
-  Eigen::MatrixXd F = A - A * P_post * A;
-  F = 0.5 * (F + F.transpose());
-  scores.score = g.head<12>();
-  scores.information = F.topLeftCorner<12, 12>();
-  // Total NIS of the update, r^T S^-1 r by Woodbury, less what the global block explains.
-  int rank_all = 0;
-  const double t_all = quadraticForm(F, g, indexRange(0, G), &rank_all);
-  const double total = residual_norm - b.dot(correction);
-  scores.rest = std::max(total - t_all, 0.0);
-  scores.rest_dof = std::max(measurement_dof - rank_all, 0);
-  return scores;
 }
 
 ConsistencyMonitor::ConsistencyMonitor(const FilterConfig& config)

@@ -31,6 +31,7 @@ ScenarioFrameResult makeFrameResult(const SimulatedFrame& frame,
   r.time_ms = time_ms;
   r.time_offset = estimate.time_offset;
   r.time_offset_sigma = estimate.time_offset_sigma;
+  r.odometry_noise_factor = estimate.odometry_noise.factor;
   return r;
 }
 

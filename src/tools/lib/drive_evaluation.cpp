@@ -34,6 +34,7 @@ struct RunRecord {
   std::vector<double> times;
   int skipped = 0;
   double elapsed = 0.0;
+  OdometryNoiseStatus odometry_noise;  ///< at the last pair
 };
 
 /// The pipeline over every pair of the source; estimates.csv written as it goes.
@@ -110,6 +111,7 @@ RunRecord runPairs(DriveSource& source, CalibrationPipeline& pipeline,
     row.time_ms = 1000.0 * result.processing_time;
     row.time_offset = result.estimate.time_offset;
     row.time_offset_sigma = result.estimate.time_offset_sigma;
+    run.odometry_noise = result.estimate.odometry_noise;
     estimates_csv.write(row);
     run.estimates.push_back(row);
     run.times.push_back(row.time_ms);
@@ -221,6 +223,11 @@ int evaluateDrive(DriveSource& source, const EstimatorConfig& config, const Ster
   text << "Pairs processed: " << run.estimates.size() << ", not used: " << run.skipped
        << "; time per frame: median " << timing.median << " ms, p95 " << timing.p95 << " ms; total "
        << run.elapsed << " s (" << run.estimates.size() / run.elapsed << " frames/s)\n";
+  if (run.odometry_noise.enabled) {
+    const std::string learned = run.odometry_noise.message();
+    text << "Odometry noise at the last pair: "
+         << (learned.empty() ? "as configured (odometry_noise_window_s)" : learned) << "\n";
+  }
   for (const std::string& note : options.notes) text << note << "\n";
   out << text.str();
   std::ofstream(options.out + "/table.txt") << text.str();

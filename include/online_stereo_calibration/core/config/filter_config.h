@@ -281,6 +281,10 @@ struct FilterConfig {
   /// scale; the reported covariance adds what kappa leaves open, kappa^2 t t^T over the
   /// translations t (StereoCalibrationEstimator::estimate). 0 = the odometry's scale is exact.
   double odometry_scale_sigma = 0.01;
+  /// s, window over which the odometry noise matcher (odometry_noise_matcher.h) learns the
+  /// odometry's noise from the updates' innovations: the configured motion noise times a
+  /// learned factor (>= 1) per part, translation and rotation. 0 = the configured noise as it is.
+  double odometry_noise_window = 0.0;
 
   // --- x_camr's drift rate as a state (issue 15) ---
   /// Steady-state 1 sigma (rad/s, per axis) of the rate at which x_camr's rotation drifts:

@@ -25,6 +25,7 @@ enum class FrameEvent {
   kNoPointInitialised,           ///< stereo pairs came, none triangulates: the baseline guess?
   kNoPointMeasurable,            ///< tracked points measured, none predictable, for 10 pairs
   kCovarianceRepaired,           ///< the calibration covariance had to be made positive definite
+  kOdometryNoiseLearned,         ///< OdometryNoiseMatcher raised the motion noise (or set it back)
 };
 
 /// A short name of the event (the key the node's diagnostics count it under).

@@ -16,6 +16,7 @@
 
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
+#include "online_stereo_calibration/core/filter/consistency_monitor.h"
 
 namespace osc {
 

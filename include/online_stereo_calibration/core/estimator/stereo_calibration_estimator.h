@@ -20,10 +20,12 @@
 #include "online_stereo_calibration/core/estimator/jump_test.h"
 #include "online_stereo_calibration/core/estimator/left_camera_gap_check.h"
 #include "online_stereo_calibration/core/estimator/mounting_from_motion.h"
+#include "online_stereo_calibration/core/estimator/odometry_noise_matcher.h"
 #include "online_stereo_calibration/core/estimator/restart_from_estimate.h"
 #include "online_stereo_calibration/core/estimator/right_camera_score_test.h"
 #include "online_stereo_calibration/core/estimator/types.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
+#include "online_stereo_calibration/core/filter/consistency_monitor.h"
 #include "online_stereo_calibration/core/geometry/camera_model.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 
@@ -41,6 +43,8 @@ struct CalibrationEstimate {
   Eigen::Vector3d excitation = Eigen::Vector3d::Ones();
   /// The filter's consistency monitor: per-block statistics and the drift-noise factors.
   ConsistencyStatus consistency;
+  /// What the odometry noise matcher learned: factors on the configured motion noise.
+  OdometryNoiseStatus odometry_noise;
   /// The camera-odometry time offset (CalibrationFilter::timeOffset): camera clock minus
   /// odometry clock (s; FilterConfig::initial_time_offset), and its 1 sigma (0 = not
   /// estimated).
@@ -188,6 +192,9 @@ class StereoCalibrationEstimator {
   void followFilter();
   /// The monitor's drift-noise factors onto the filter (after every change of the monitor).
   void setFilterDriftInflation();
+  /// The odometry noise matcher learns from the step's update; its factors onto the filter,
+  /// and FrameEvent::kOdometryNoiseLearned when the noise is raised or set back.
+  void learnOdometryNoise(const MotionIncrement& motion, FrameReport* report);
   /// While no point can be initialised: BaselineRestart's pair, and x_camr re-seeded at the
   /// length from motion when it proposes it (FilterConfig::baseline_from_motion).
   void learnBaselineLength(const MotionIncrement& motion, bool motion_links_pairs,
@@ -230,6 +237,8 @@ class StereoCalibrationEstimator {
   ConsistencyMonitor monitor_;
   int monitor_starts_ = 0;      ///< CalibrationFilter::starts() the monitor has followed
   int monitor_reopenings_ = 0;  ///< CalibrationFilter::reopenings() it has followed
+  /// Odometry model: the motion noise learned from the updates' innovations.
+  OdometryNoiseMatcher noise_matcher_;
 };
 
 }  // namespace osc

@@ -26,12 +26,12 @@
 
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/types.h"
-#include "online_stereo_calibration/core/filter/consistency_monitor.h"
 #include "online_stereo_calibration/core/filter/measurement_model.h"
 #include "online_stereo_calibration/core/filter/motion_excitation.h"
 #include "online_stereo_calibration/core/filter/point_coordinates.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/filter/unscented_transform.h"
+#include "online_stereo_calibration/core/filter/update_scores.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 
 namespace osc {
@@ -178,7 +178,7 @@ class CalibrationFilter {
   /// Adds @p added (rad^2, per axis) to the variances of @p block's rotation; mean, points and
   /// correlations kept (a widening on evidence, not a re-opening).
   void widenRotationVariance(JumpBlock block, const Eigen::Vector3d& added);
-  /// The last step's update scores (consistency_monitor.h), nullptr when its final pass made no
+  /// The last step's update scores (update_scores.h), nullptr when its final pass made no
   /// monitored update (no measurement, a tempered update, the monitor off).
   const UpdateScores* lastUpdateScores() const { return has_scores_ ? &scores_ : nullptr; }
   /// How many times the filter was started (reset, restartCalibration): a component that
@@ -194,6 +194,18 @@ class CalibrationFilter {
     if (factors == drift_inflation_) return;
     drift_inflation_ = factors;
     last_prediction_.reset();
+  }
+  /// The factors on the configured motion noise's variance, translation and rotation, from the
+  /// next prediction on (the odometry noise matcher's; 1 = as configured). A prediction kept
+  /// by predictObservations with other factors is dropped.
+  void setMotionNoiseFactors(const std::array<double, 2>& factors) {
+    if (factors == motion_noise_factors_) return;
+    motion_noise_factors_ = factors;
+    last_prediction_.reset();
+  }
+  /// The last step's evidence on the motion noise (none: no update, or the per-point model).
+  const MotionNoiseEvidence* lastMotionNoiseEvidence() const {
+    return has_motion_evidence_ ? &motion_evidence_ : nullptr;
   }
   /// How much of the recent vehicle rotation is excitation, per axis (MotionExcitation).
   Eigen::Vector3d excitationGains() const { return excitation_.gains(); }
@@ -262,6 +274,9 @@ class CalibrationFilter {
   }
   /// The start covariance: @p calibration and the odometry state's prior, uncorrelated.
   Eigen::MatrixXd startCovariance(const Matrix12d& calibration) const;
+  /// The step's motion noise before motion_noise_factors_: the odometry's own covariance of
+  /// the increment when it gives one, else the configured model.
+  Matrix6d configuredMotionNoise(const MotionIncrement& motion) const;
   /// The step's vehicle motion at the current odometry states, and its derivative (boxPlus
   /// tangent) with respect to them (6 x odometry_dim_).
   void motionModel(const MotionIncrement& motion, Eigen::Isometry3d* corrected,
@@ -326,6 +341,7 @@ class CalibrationFilter {
   int reopenings_ = 0;
   /// Factors on x_caml's and x_camr's random walk (setDriftInflation).
   std::array<double, 2> drift_inflation_ = {1.0, 1.0};
+  std::array<double, 2> motion_noise_factors_ = {1.0, 1.0};
   PointCoordinates coordinates_;  ///< how TrackedPoint::mean stores a point
   UnscentedParameters ut_;
   StereoIntrinsics intrinsics_;
@@ -342,6 +358,8 @@ class CalibrationFilter {
   /// The final pass's scores of this step, for the monitor (has_scores_: an update ran).
   UpdateScores scores_;
   bool has_scores_ = false;
+  MotionNoiseEvidence motion_evidence_;
+  bool has_motion_evidence_ = false;
 };
 
 }  // namespace osc

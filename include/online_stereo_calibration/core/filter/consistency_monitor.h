@@ -59,6 +59,7 @@
 #include <Eigen/Core>
 
 #include "online_stereo_calibration/core/config/filter_config.h"
+#include "online_stereo_calibration/core/filter/update_scores.h"
 
 namespace osc {
 
@@ -72,17 +73,6 @@ constexpr int kConsistencyBlocks = 3;
 
 /// "x_caml", "x_camr", "points".
 const char* consistencyBlockName(ConsistencyBlock block);
-
-/// One update's evidence: the score of a calibration shift and its covariance, and what
-/// no shift of the global error explains.
-struct UpdateScores {
-  Eigen::Matrix<double, 12, 1> score =
-      Eigen::Matrix<double, 12, 1>::Zero();  ///< g (x_caml, x_camr)
-  Eigen::Matrix<double, 12, 12> information =
-      Eigen::Matrix<double, 12, 12>::Zero();  ///< F = Cov(g) under the model
-  double rest = 0.0;                          ///< T_rest
-  int rest_dof = 0;                           ///< 4 N - rank(F of the global error)
-};
 
 /// The partial score statistics of a calibration shift from a (summed) score and its
 /// information, per block (x_caml, x_camr) with their degrees of freedom (the rank).
@@ -129,21 +119,6 @@ struct ConsistencyStatus {
   /// both), "... not explained by the calibration" for the points alone, else empty.
   std::string message() const;
 };
-
-/// Upper quantile of chi-square with `dof` degrees of freedom: P(X > q) = probability
-/// (Wilson-Hilferty; within 1 % for dof >= 10 at probability >= 1e-6).
-double chiSquareUpperQuantile(double dof, double probability);
-
-/// The evidence of one linearised update (see the file comment). The global error
-/// has G dimensions with x_caml at 0, x_camr at 6 (state_layout.h).
-/// @param information A = sum J_i^T S0_i^-1 J_i (G x G)
-/// @param score b = sum J_i^T S0_i^-1 r_i (G)
-/// @param residual_norm sum r_i^T S0_i^-1 r_i
-/// @param posterior_covariance P+ = (P^-1 + A)^-1 (G x G)
-/// @param measurement_dof 4 N
-UpdateScores computeUpdateScores(const Eigen::MatrixXd& information, const Eigen::VectorXd& score,
-                                 double residual_norm, const Eigen::MatrixXd& posterior_covariance,
-                                 int measurement_dof);
 
 /// The sliding-window test and the inflation factors it drives.
 class ConsistencyMonitor {

@@ -3,6 +3,7 @@
 /// front end would: observations in, dropped tracks fed back to the simulated tracker.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -40,6 +41,9 @@ struct ScenarioFrameResult {
   /// Estimated camera-odometry time offset and its 1 sigma (s; sigma 0: not estimated).
   double time_offset = 0.0;
   double time_offset_sigma = 0.0;
+  /// The odometry noise matcher's factors on the configured motion noise's variance,
+  /// translation and rotation (1: as configured; odometry_noise_matcher.h).
+  std::array<double, 2> odometry_noise_factor = {1.0, 1.0};
 };
 
 /// One frame's result from the estimate after it, the truth and the estimator's report.
