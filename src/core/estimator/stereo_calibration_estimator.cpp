@@ -8,6 +8,7 @@
 
 #include "online_stereo_calibration/core/estimator/epipolar_consistency.h"
 #include "online_stereo_calibration/core/estimator/hand_eye_start.h"
+#include "online_stereo_calibration/core/filter/process_model.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 #include "online_stereo_calibration/core/geometry/rotation.h"
@@ -190,27 +191,6 @@ FrameReport StereoCalibrationEstimator::processFrame(
   reopenIfOffEpipolarLines(&tracked, &candidates, &report);
 
   if (has_previous_frame_) {
-    // A handful of points moved the calibration by more than they told it (a dim stretch of
-    // 1-4 correct points per pair walked roll_l from 1.9 to 3.5 sigma off while its sigma
-    // shrank 6 %): predict only, and let those points start afresh (issue 14: keep the
-    // estimate and wait).
-    // Counted with the new candidates: a start whose guess triangulates few of many pairs
-    // is thin evidence, which tempering handles, not a texture-poor view.
-    const int needed = config_.min_points_to_update;
-    const int seen = static_cast<int>(tracked.size() + candidates.size());
-    report.too_few_points = !tracked.empty() && seen < needed;
-    if (report.too_few_points) {
-      if (!held_for_few_points_) {
-        report.events.add(FrameEvent::kTooFewPoints,
-                          "too few points: " + std::to_string(seen) +
-                              " stereo pairs, fewer than min_points_to_update " +
-                              std::to_string(needed) +
-                              "; the calibration is kept, not updated, until more are seen");
-      }
-      candidates.insert(candidates.end(), tracked.begin(), tracked.end());
-      tracked.clear();
-    }
-    held_for_few_points_ = report.too_few_points;
     gap_check_.beforeStep(&monitor_, !tracked.empty());
     report.step = filter_.step(motion, tracked, [this](const GateOutcome& gate) {
       return jump_test_.decide(gate, filter_);
@@ -444,7 +424,6 @@ void StereoCalibrationEstimator::warnIfNoPointMeasurable(
 
 void StereoCalibrationEstimator::forgetDriveEvidence() {
   baseline_restart_.forget();
-  held_for_few_points_ = false;
   unmeasurable_pairs_ = 0;
   knock_test_.reset();
   mounting_.clear();
@@ -471,7 +450,7 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
   // the odometry's scale adds there, so that save -> restore -> estimate() gives it back. If
   // that leaves it indefinite (a prior sharper than the odometry's scale allows, e.g. sigmas
   // only), the filter starts from it as given and reports it widened by the scale.
-  const Matrix12d scale = odometryScaleCovariance(guess);
+  const Matrix12d scale = odometryScaleCovariance(config_, guess);
   const Matrix12d internal = tangent_covariance - scale;
   filter_.reset(guess, scale.isZero() || internal.llt().info() != Eigen::Success
                            ? tangent_covariance
@@ -482,25 +461,13 @@ void StereoCalibrationEstimator::reset(const StereoExtrinsics& guess,
   restart_.anchorHere(filter_, JumpBlock::kNone, Vector6d::Zero());
 }
 
-Matrix12d StereoCalibrationEstimator::odometryScaleCovariance(
-    const StereoExtrinsics& extrinsics) const {
-  if (!(config_.odometry_scale_sigma > 0.0)) return Matrix12d::Zero();
-  // Scaling every translation by 1 + kappa explains the pixels as well (filter_config.h):
-  // the translations' tangent errors share kappa * t. Translations are parameters as they
-  // are (no Jacobian needed: their tangent and parameter coordinates agree).
-  Vector12d t = Vector12d::Zero();
-  t.segment<3>(layout::kCaml + layout::kTranslation) = extrinsics.T_veh_caml.translation();
-  t.segment<3>(layout::kCamr + layout::kTranslation) = extrinsics.T_caml_camr.translation();
-  return std::pow(config_.odometry_scale_sigma, 2) * t * t.transpose();
-}
-
 CalibrationEstimate StereoCalibrationEstimator::estimate() const {
   CalibrationEstimate e;
   e.extrinsics = filter_.extrinsics();
   e.parameters = e.extrinsics.toParameters();
   e.tangent_covariance = filter_.covariance();
   e.parameter_covariance = filter_.parameterCovariance();
-  e.odometry_scale_covariance = odometryScaleCovariance(e.extrinsics);
+  e.odometry_scale_covariance = odometryScaleCovariance(config_, e.extrinsics);
   e.tangent_covariance += e.odometry_scale_covariance;
   e.parameter_covariance += e.odometry_scale_covariance;
   e.tracked_points = filter_.pointCount();

@@ -115,6 +115,17 @@ Matrix6d motionNoiseCovariance(const FilterConfig& config, double dt) {
   return (sigma.array().square() * s).matrix().asDiagonal();
 }
 
+Matrix12d odometryScaleCovariance(const FilterConfig& config, const StereoExtrinsics& extrinsics) {
+  if (!(config.odometry_scale_sigma > 0.0)) return Matrix12d::Zero();
+  // Scaling every translation by 1 + kappa explains the pixels as well (filter_config.h):
+  // the translations' tangent errors share kappa * t. Translations are parameters as they
+  // are (no Jacobian needed: their tangent and parameter coordinates agree).
+  Vector12d t = Vector12d::Zero();
+  t.segment<3>(layout::kCaml + layout::kTranslation) = extrinsics.T_veh_caml.translation();
+  t.segment<3>(layout::kCamr + layout::kTranslation) = extrinsics.T_caml_camr.translation();
+  return std::pow(config.odometry_scale_sigma, 2) * t * t.transpose();
+}
+
 Eigen::Matrix3d paperPointProcessNoise(const Eigen::Vector3d& point_lopt, double sigma_imu,
                                        double sigma_p) {
   const Eigen::Vector3d p = rotationBodyOptical() * point_lopt;  // body axes: x fwd, y left, z up

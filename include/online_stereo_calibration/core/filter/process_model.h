@@ -91,6 +91,11 @@ Matrix12d calibrationDriftCovariance(const FilterConfig& config, double dt);
 /// (shared motion-noise model; eq. 15 for the rotation).
 Matrix6d motionNoiseCovariance(const FilterConfig& config, double dt);
 
+/// What the odometry's scale uncertainty (FilterConfig::odometry_scale_sigma) adds to the
+/// covariance of the translations of @p extrinsics, in the calibration's error layout (equal
+/// to its parameters' for translations); zero when the scale is exact.
+Matrix12d odometryScaleCovariance(const FilterConfig& config, const StereoExtrinsics& extrinsics);
+
 /// Seed eq. 14-27: the paper's diagonal process noise of one point, computed in the camera
 /// *body* axes (x forward, y left, z up, as the paper's figures) and returned in the left
 /// optical frame. sigma_imu: angular motion error (rad); sigma_p: eq. 14 (m).
