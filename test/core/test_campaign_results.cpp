@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include "campaign_test_support.h"
-#include "temp_dir.h"
 
 #include <algorithm>
 #include <cmath>
