@@ -1,6 +1,8 @@
 /// @file temp_dir.h
 /// @brief A fresh directory under /tmp for one test, removed with everything in it at the end
-/// (shared by the tests that write files: test_tools_files, test_campaign).
+/// (shared by the tests that write files: test_calibration_file, test_estimates_csv_and_evaluation,
+/// test_scenario_file_and_drive_simulation, test_campaign, test_campaign_ranges_and_draw,
+/// test_kitti_raw_drive).
 #pragma once
 
 #include <dirent.h>

@@ -1,6 +1,8 @@
-// Tests of the procedural scene and its renderer: exact ground truth (pixel <-> surface
-// point round trips for every distortion model, occlusion), image properties the front end
-// relies on (stereo patches agree, corners are plentiful), determinism and validation.
+// Tests of the renderer of the procedural scene: exact ground truth (pixel <-> surface point
+// round trips for every distortion model, pixels without a ray, occlusion, the exact ray cast),
+// image properties the front end relies on (stereo patches agree, corners are plentiful,
+// structures line a long drive), noise, exposure and blur, determinism, concurrency, and the
+// render options' validation.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -15,21 +17,10 @@
 #include "online_stereo_calibration/core/geometry/pose.h"
 #include "online_stereo_calibration/core/sim/image_scenario_runner.h"
 #include "online_stereo_calibration/core/sim/stereo_scene_renderer.h"
+#include "stereo_scene_test_support.h"
 
 namespace osc {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-CameraModel pinhole(int width = 640, int height = 480, double focal = 500.0) {
-  CameraIntrinsics in;
-  in.width = width;
-  in.height = height;
-  in.fx = in.fy = focal;
-  in.cx = 0.5 * (width - 1);
-  in.cy = 0.5 * (height - 1);
-  return CameraModel(in);
-}
 
 /// EuRoC cam0's plumb_bob intrinsics (k2 keeps the distortion one-to-one over the image).
 CameraModel euroc() {
@@ -81,65 +72,6 @@ CameraModel rational() {
   in.model = DistortionModel::kRationalPolynomial;
   in.distortion = {-0.25, 0.06, 1e-4, -2e-4, 0.0, 0.05, 0.01, 0.0};
   return CameraModel(in);
-}
-
-/// Left optical frame of a vehicle-mounted camera 1.5 m above the ground at (x, y).
-Eigen::Isometry3d cameraPose(const ProceduralScene& scene, double x, double y, double yaw,
-                             double pitch = 0.05) {
-  Vector6d body;
-  body << x, y, scene.groundHeight(x, y) + 1.5, 0.0, pitch, yaw;
-  return poseFromParameters(body) * bodyFromOptical();
-}
-
-/// The right camera: `baseline` metres to the right of the left one (optical x is right).
-Eigen::Isometry3d rightOf(const Eigen::Isometry3d& left, double baseline = 0.5) {
-  Eigen::Isometry3d offset = Eigen::Isometry3d::Identity();
-  offset.translation() = Eigen::Vector3d(baseline, 0.0, 0.0);
-  return left * offset;
-}
-
-const StereoSceneRenderer& defaultRenderer() {
-  static const StereoSceneRenderer renderer{SceneConfig()};
-  return renderer;
-}
-
-void expectRejected(const SceneConfig& config, const std::string& field) {
-  try {
-    const ProceduralScene scene(config);
-    ADD_FAILURE() << "config with a bad " << field << " was accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-  }
-}
-
-TEST(SceneConfig, DefaultIsValid) { EXPECT_TRUE(SceneConfig().validate().empty()); }
-
-TEST(SceneConfig, BadFieldsAreRejectedByName) {
-  SceneConfig c;
-  c.structure_density = -1.0;
-  expectRejected(c, "structure_density");
-  c = SceneConfig();
-  c.ground_undulation = std::nan("");
-  expectRejected(c, "ground_undulation");
-  c = SceneConfig();
-  c.min_structure_distance = 90.0;
-  expectRejected(c, "max_structure_distance");
-  c = SceneConfig();
-  c.backdrop_distance = 50.0;
-  expectRejected(c, "backdrop_distance");
-  c = SceneConfig();
-  c.path = {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(std::nan(""), 1.0)};
-  expectRejected(c, "path");
-  c = SceneConfig();
-  c.path = {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(30000.0, 0.0)};
-  expectRejected(c, "path");
-  c = SceneConfig();
-  c.extra_primitives.emplace_back();
-  c.extra_primitives.back().size.x() = -1.0;
-  expectRejected(c, "extra_primitives[0]");
-  c = SceneConfig();
-  c.ambient = 2.0;
-  expectRejected(c, "ambient");
 }
 
 TEST(RenderOptions, BadFieldsAreRejectedByName) {
@@ -433,46 +365,6 @@ TEST(StereoSceneRenderer, StereoPatchesAgreeAtTrueCorrespondences) {
   EXPECT_LT(median(shifted), 0.4);
 }
 
-TEST(StereoMatchTruth, ExactPairsPairsWithinTheToleranceAndWrongPairs) {
-  const StereoSceneRenderer& r = defaultRenderer();
-  const CameraModel camera = pinhole();
-  const Eigen::Isometry3d left = cameraPose(r.scene(), 0.0, 0.0, 0.2);
-  const Eigen::Isometry3d right = rightOf(left);
-  const double tolerance = 1.5;
-  int checked = 0;
-  for (const Eigen::Vector2d& l :
-       {Eigen::Vector2d(320, 400), Eigen::Vector2d(200, 350), Eigen::Vector2d(450, 300)}) {
-    const std::optional<Eigen::Vector3d> p = r.surfacePoint(camera, left, l);
-    Eigen::Vector2d q;
-    if (!p || !r.projectVisible(camera, right, *p, &q)) continue;
-    ++checked;
-    // The true pair: the exact surface point.
-    const StereoMatchTruth exact =
-        checkStereoMatch(r, camera, camera, left, right, l, q, tolerance);
-    EXPECT_TRUE(exact.at_pixel);
-    ASSERT_TRUE(exact.point.has_value());
-    EXPECT_LT((*exact.point - *p).norm(), 1e-6);
-    // Both pixels 1.2 px off, in opposite directions: the surface at the left pixel projects
-    // ~2.4 px from the right one, but p is within 1.2 px of both: correct, not at the pixel.
-    const Eigen::Vector2d off(1.2, 0.0);
-    const StereoMatchTruth near =
-        checkStereoMatch(r, camera, camera, left, right, l + off, q - off, tolerance);
-    EXPECT_FALSE(near.at_pixel);
-    EXPECT_TRUE(near.point.has_value());
-    EXPECT_FALSE(
-        scenePointsOfStereoMatch(r, camera, camera, left, right, l + off, q - off, tolerance)
-            .empty());
-    // 2.5 px off each way: no scene point explains the pair.
-    const Eigen::Vector2d far(2.5, 0.0);
-    EXPECT_FALSE(
-        checkStereoMatch(r, camera, camera, left, right, l + far, q - far, tolerance).point);
-    EXPECT_TRUE(
-        scenePointsOfStereoMatch(r, camera, camera, left, right, l + far, q - far, tolerance)
-            .empty());
-  }
-  EXPECT_GE(checked, 2);
-}
-
 TEST(StereoSceneRenderer, TexturesAreRichInCorners) {
   const StereoSceneRenderer& r = defaultRenderer();
   const cv::Mat image = r.render(pinhole(), cameraPose(r.scene(), 0.0, 0.0, 0.0));
@@ -527,48 +419,6 @@ TEST(StereoSceneRenderer, StructuresLineALongDriveAndKeepClearOfIt) {
   std::vector<cv::KeyPoint> fast;
   cv::FAST(image, fast, 20, true);
   EXPECT_GE(fast.size(), 300u);
-}
-
-TEST(ProceduralScene, GroundHitsLieOnTheHeightField) {
-  const ProceduralScene& scene = defaultRenderer().scene();
-  const Eigen::Vector3d origin(3.0, 4.0, scene.groundHeight(3.0, 4.0) + 1.5);
-  int ground_hits = 0;
-  double lowest = 0.0, highest = 0.0;
-  for (int k = 0; k < 2000; ++k) {
-    const double azimuth = 0.0031 * k * 2.0 * kPi, depression = 0.02 + 0.0007 * k;
-    const Eigen::Vector3d d(std::cos(azimuth) * std::cos(depression),
-                            std::sin(azimuth) * std::cos(depression), -std::sin(depression));
-    SceneHit hit;
-    if (!scene.intersect(origin, d, 1e9, &hit) || hit.surface != SceneHit::Surface::kGround)
-      continue;
-    ++ground_hits;
-    EXPECT_NEAR(hit.point.z(), scene.groundHeight(hit.point.x(), hit.point.y()), 1e-9);
-    EXPECT_NEAR(hit.normal.norm(), 1.0, 1e-6);
-    EXPECT_GT(hit.normal.z(), 0.95);  // gentle slopes
-    lowest = std::min(lowest, hit.point.z());
-    highest = std::max(highest, hit.point.z());
-  }
-  EXPECT_GT(ground_hits, 1000);
-  EXPECT_GE(lowest, -SceneConfig().ground_undulation - 1e-9);
-  EXPECT_LE(highest, SceneConfig().ground_undulation + 1e-9);
-  EXPECT_GT(highest - lowest, 0.1);  // it does undulate
-}
-
-TEST(ProceduralScene, BackdropAndSky) {
-  SceneConfig config;
-  config.generate_structures = false;
-  const ProceduralScene scene(config);
-  const Eigen::Vector3d circle = scene.backdropCircle();
-  EXPECT_NEAR(circle.z(), config.backdrop_distance, 1e-9);  // path = the origin
-  const Eigen::Vector3d origin(0.0, 0.0, 1.5);
-  SceneHit hit;
-  // Just above the horizon: the backdrop wall, backdrop_distance away.
-  ASSERT_TRUE(
-      scene.intersect(origin, Eigen::Vector3d(std::cos(0.01), 0.0, std::sin(0.01)), 1e9, &hit));
-  EXPECT_EQ(hit.surface, SceneHit::Surface::kBackdrop);
-  EXPECT_NEAR(hit.point.head<2>().norm(), config.backdrop_distance, 1e-6);
-  // Steeply up: the sky (no surface point).
-  EXPECT_FALSE(scene.intersect(origin, Eigen::Vector3d(0.6, 0.0, 0.8), 1e9, &hit));
 }
 
 TEST(StereoSceneRenderer, ConcurrentRendersAgreeWithSequentialOnes) {
