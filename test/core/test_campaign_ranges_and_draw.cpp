@@ -262,6 +262,44 @@ TEST(CampaignDraw, TheSteeringPhaseIsDrawnOnItsOwnStreamAndLeavesTheRestOfTheRun
   EXPECT_EQ(recorded.scenario.motion.yaw_phase, 0.0);
 }
 
+TEST(CampaignDraw, TheWhiteNoiseFactorScalesTheOdometryNoiseAndIsDrawnLast) {
+  // A GPS/INS noisier than the filter assumes (issue "Real drives in"): the simulated white
+  // motion noise times a drawn factor. Drawn after everything else, so that the shipped [1, 1]
+  // leaves every run as it was drawn before the key existed.
+  const CampaignRanges shipped = parseCampaignRanges(kNoRecorded, "t");
+  ASSERT_EQ(shipped.white_noise_factor.min, 1.0);
+  ASSERT_EQ(shipped.white_noise_factor.max, 1.0);
+  const CampaignRanges noisier = parseCampaignRanges(
+      "motion: {kind: {offroad: 1, urban: 1}}\nodometry: {white_noise_factor: [1, 4]}", "t");
+  const MeasurementScenario defaults;
+  double largest = 1.0;
+  for (int run = 0; run < 50; ++run) {
+    const CampaignRunSpec a = drawCampaignRun(shipped, run, 7 + run, 600, true);
+    const CampaignRunSpec b = drawCampaignRun(noisier, run, 7 + run, 600, true);
+    EXPECT_EQ(a.scenario.motion_translation_noise, defaults.motion_translation_noise);
+    EXPECT_EQ(settingOf(a.settings, "odo_white_noise_factor"), "1");
+    const double factor = std::stod(settingOf(b.settings, "odo_white_noise_factor"));
+    ASSERT_GE(factor, 1.0);
+    ASSERT_LE(factor, 4.0);
+    largest = std::max(largest, factor);
+    EXPECT_NEAR(b.scenario.motion_translation_noise, factor * defaults.motion_translation_noise,
+                1e-5 * b.scenario.motion_translation_noise);  // the setting has 6 digits
+    EXPECT_NEAR(b.scenario.motion_rotation_noise, factor * defaults.motion_rotation_noise,
+                1e-5 * b.scenario.motion_rotation_noise);
+    for (size_t i = 0; i < a.settings.size(); ++i) {
+      if (a.settings[i].first != "odo_white_noise_factor") {
+        EXPECT_EQ(a.settings[i], b.settings[i]) << run;
+      }
+    }
+    EXPECT_EQ(a.scenario.initial_error, b.scenario.initial_error);
+    EXPECT_EQ(a.image_options.render.noise_sigma, b.image_options.render.noise_sigma);
+  }
+  EXPECT_GT(largest, 3.0);
+  EXPECT_NE(parseError(std::string(kNoRecorded) + "odometry: {white_noise_factor: 0.5}")
+                .find("odometry.white_noise_factor"),
+            std::string::npos);
+}
+
 TEST(CampaignDraw, RecordedTrajectoryStretchLiesInTheFile) {
   TempDir dir;
   {

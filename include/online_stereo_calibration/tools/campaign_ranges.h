@@ -85,6 +85,10 @@ struct CampaignRanges {
   DrawRange rotation_rate_bias_deg_s{0, 0.01};  ///< odometry.rotation_rate_bias_deg_s (std)
   DrawRange velocity_bias_mps{0, 0.02};         ///< odometry.velocity_bias_mps (std)
   DrawRange bias_correlation_time_s{30, 30};    ///< odometry.bias_correlation_time_s
+  /// odometry.white_noise_factor: the simulated white motion noise's 1 sigma, translation and
+  /// rotation, times the scenario's (which the filter assumes); drawn last, so that [1, 1]
+  /// leaves every other draw as it was.
+  DrawRange white_noise_factor{1, 1};
 
   // --- scene (both levels) -------------------------------------------------------------------
   DrawRange blind_stretches{0, 1};           ///< scene.blind_stretches (integer count)

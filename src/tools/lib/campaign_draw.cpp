@@ -125,6 +125,7 @@ std::vector<std::string> campaignSettingNames(bool images) {
       names.push_back(name);
     }
   }
+  names.push_back("odo_white_noise_factor");  // drawn last
   return names;
 }
 
@@ -384,6 +385,12 @@ CampaignRunSpec drawCampaignRun(const CampaignRanges& ranges, int run, unsigned 
     set("image_blur_px", number(image.render.blur_sigma));
     set("image_flicker", number(image.exposure_variation));
   }
+
+  // --- the odometry's white noise, drawn last (campaign_ranges.h) ---
+  const double white = draw.uniform(ranges.white_noise_factor);
+  s.motion_translation_noise *= white;
+  s.motion_rotation_noise *= white;
+  set("odo_white_noise_factor", number(white));
   return spec;
 }
 

@@ -54,6 +54,7 @@ const std::vector<DrawRangeSpec>& drawRangeSpecs() {
       {"odometry.scale_error_percent", &R::scale_error_percent, -20, 20, false},
       {"odometry.rotation_rate_bias_deg_s", &R::rotation_rate_bias_deg_s, 0, 10, false},
       {"odometry.velocity_bias_mps", &R::velocity_bias_mps, 0, 10, false},
+      {"odometry.white_noise_factor", &R::white_noise_factor, 1, 100, false},
       {"odometry.bias_correlation_time_s", &R::bias_correlation_time_s, 0.1, inf, false},
       {"scene.blind_stretches", &R::blind_stretches, 0, 10, true},
       {"scene.blind_duration_s", &R::blind_duration_s, 0.1, 600, false},
