@@ -127,9 +127,9 @@ TEST(OdometryNoiseMatcher, KeepsTheConfiguredNoiseWhenTheDataAgree) {
   OdometryNoiseMatcher matcher(options(20.0));
   int raised = 0;
   for (int step = 0; step < 600; ++step) {
-    matcher.addUpdate(0.1, nullptr);  // a step without an update changes nothing ...
+    matcher.addUpdate(0.1, nullptr, 0.0);  // a step without an update changes nothing ...
     const MotionNoiseEvidence e = update.draw(matcher.factors(), {1.0, 1.0});
-    matcher.addUpdate(0.0, &e);  // ... the evidence does
+    matcher.addUpdate(0.0, &e, 0.0);  // ... the evidence does
     raised += matcher.factors()[0] > 1.0 || matcher.factors()[1] > 1.0;
   }
   EXPECT_LE(raised, 6);
@@ -149,7 +149,7 @@ TEST(OdometryNoiseMatcher, LearnsANoisierOdometryAndForgetsIt) {
   OdometryNoiseMatcher matcher(o);
   for (int step = 0; step < 200; ++step) {
     const MotionNoiseEvidence e = update.draw(matcher.factors(), {9.0, 1.0});
-    matcher.addUpdate(0.1, &e);
+    matcher.addUpdate(0.1, &e, 0.0);
   }
   const OdometryNoiseStatus& learned = matcher.status();
   EXPECT_NEAR(learned.estimate[0], 9.0, 4.0 * learned.standard_error[0]);
@@ -163,11 +163,33 @@ TEST(OdometryNoiseMatcher, LearnsANoisierOdometryAndForgetsIt) {
 
   for (int step = 0; step < 201; ++step) {
     const MotionNoiseEvidence e = update.draw(matcher.factors(), {1.0, 1.0});
-    matcher.addUpdate(0.1, &e);
+    matcher.addUpdate(0.1, &e, 0.0);
   }
   EXPECT_EQ(matcher.factors()[0], 1.0);
   matcher.reset();
   EXPECT_EQ(matcher.status().window_updates, 0);
+}
+
+// An update made while x_caml's rotation is known no better than 1 deg (a start far off) is
+// not evidence: 100 of a 25x noisier odometry leave the window empty; settled, they count.
+TEST(OdometryNoiseMatcher, UpdatesBeforeTheMountingRotationSettledAreNotEvidence) {
+  std::mt19937 rng(9);
+  NoisyMotionUpdate update(&rng);
+  OdometryNoiseMatcher matcher(options(20.0));
+  const double unsettled = 1.5 * OdometryNoiseMatcher::kSettledRotationSigma;
+  for (int step = 0; step < 100; ++step) {
+    const MotionNoiseEvidence e = update.draw(matcher.factors(), {25.0, 25.0});
+    matcher.addUpdate(0.1, &e, unsettled);
+  }
+  EXPECT_EQ(matcher.status().window_updates, 0);
+  EXPECT_EQ(matcher.factors()[0], 1.0);
+  for (int step = 0; step < 100; ++step) {
+    const MotionNoiseEvidence e = update.draw(matcher.factors(), {25.0, 25.0});
+    matcher.addUpdate(0.1, &e, OdometryNoiseMatcher::kSettledRotationSigma);
+  }
+  EXPECT_EQ(matcher.status().window_updates, 100);
+  EXPECT_GT(matcher.factors()[0], 5.0);
+  EXPECT_GT(matcher.factors()[1], 5.0);
 }
 
 // Off (window 0): no evidence is kept and the factors stay 1.
@@ -177,7 +199,7 @@ TEST(OdometryNoiseMatcher, OffLearnsNothing) {
   OdometryNoiseMatcher matcher(options(0.0));
   for (int step = 0; step < 100; ++step) {
     const MotionNoiseEvidence e = update.draw({1.0, 1.0}, {25.0, 25.0});
-    matcher.addUpdate(0.1, &e);
+    matcher.addUpdate(0.1, &e, 0.0);
   }
   EXPECT_FALSE(matcher.status().enabled);
   EXPECT_EQ(matcher.factors()[0], 1.0);
@@ -214,14 +236,15 @@ DriveOutcome drive(double translation_noise, double window) {
 
 // The paper's drive with the odometry's translation noise 5x the configured 2 mm a step:
 // the factor learned is that of the truth (25) within a factor 2, and all 12 errors are within
-// 3 sigma in at least 95 % of the frames. With the configured noise the factor is 1 from
-// frame 50 on: only the start's first updates, linearised 0.5 m and 10 deg off, raise it (to
-// 2.1).
+// 3 sigma in at least 90 % of the frames from frame 30 (below 50 % without the matcher). With
+// the configured noise the factor is 1 from frame 50 on.
 TEST(OdometryNoiseMatcher, PaperDriveWithANoisierOdometryIsLearned) {
   const DriveOutcome noisy = drive(0.01, 20.0);
+  const DriveOutcome unlearned = drive(0.01, 0.0);
   EXPECT_GT(noisy.factor[0], 12.5);
   EXPECT_LT(noisy.factor[0], 50.0);
-  EXPECT_GE(noisy.within_3sigma, 0.95);
+  EXPECT_GE(noisy.within_3sigma, 0.9);      // 0.94 (learned from frame ~20 on, x_caml settled)
+  EXPECT_LT(unlearned.within_3sigma, 0.5);  // 0.03
   const DriveOutcome matched = drive(0.002, 20.0);
   EXPECT_FALSE(matched.raised_after_50);
   EXPECT_LT(matched.largest, 4.0);

@@ -422,6 +422,7 @@ FilterConfig paperFilterConfig() {
   config.baseline_from_motion = 0;            // ... and the baseline from its points alone
   config.initial_time_offset_sigma = 0.0;     // the paper takes the odometry as synchronised
   config.odometry_scale_sigma = 0.0;          // ... and exact in scale
+  config.odometry_noise_window = 0.0;         // ... with the noise it was told
   config.odometry_velocity_bias_sigma = 0.0;  // ... and without a velocity error
   config.odometry_forward_velocity_bias_sigma = 0.0;
   config.camr_rotation_drift_rate_sigma = 0.0;  // ... and a right camera that does not drift

@@ -43,10 +43,13 @@ void OdometryNoiseMatcher::reset() {
   learn();
 }
 
-void OdometryNoiseMatcher::addUpdate(double dt, const MotionNoiseEvidence* evidence) {
+void OdometryNoiseMatcher::addUpdate(double dt, const MotionNoiseEvidence* evidence,
+                                     double caml_rotation_sigma) {
   if (!status_.enabled) return;
   time_ += dt;
-  if (evidence) window_entries_.push_back({time_, *evidence});
+  if (evidence && caml_rotation_sigma <= kSettledRotationSigma) {
+    window_entries_.push_back({time_, *evidence});
+  }
   while (!window_entries_.empty() && window_entries_.front().time <= time_ - options_.window) {
     window_entries_.pop_front();
   }
@@ -61,7 +64,10 @@ void OdometryNoiseMatcher::learn() {
     double excess = 0.0, dof = 0.0, growth = 0.0;
     for (const Entry& entry : window_entries_) {
       const MotionNoiseEvidence& e = entry.evidence;
-      excess += e.statistic[p] - e.dof[p] + e.applied_factor[p] * e.growth[p];
+      // One update's statistic counts at most up to its chi-square bound: a few updates
+      // linearised far off (a start 20 deg off) do not make a noisy odometry on their own.
+      const double bound = chiSquareUpperQuantile(e.dof[p], kFalseAlarm);
+      excess += std::min(e.statistic[p], bound) - e.dof[p] + e.applied_factor[p] * e.growth[p];
       dof += e.dof[p];
       growth += e.growth[p];
     }

@@ -84,7 +84,10 @@ void StereoCalibrationEstimator::setFilterDriftInflation() {
 void StereoCalibrationEstimator::learnOdometryNoise(const MotionIncrement& motion,
                                                     FrameReport* report) {
   const std::string before = noise_matcher_.status().message();
-  noise_matcher_.addUpdate(motion.dt, filter_.lastMotionNoiseEvidence());
+  const double caml_rotation_sigma = std::sqrt(std::max(
+      filter_.covariance().diagonal().segment<3>(layout::kCaml + layout::kRotation).maxCoeff(),
+      0.0));
+  noise_matcher_.addUpdate(motion.dt, filter_.lastMotionNoiseEvidence(), caml_rotation_sigma);
   filter_.setMotionNoiseFactors(noise_matcher_.factors());
   const std::string after = noise_matcher_.status().message();
   if (before.empty() != after.empty()) {

@@ -273,8 +273,11 @@ struct FilterConfig {
   double odometry_scale_sigma = 0.01;
   /// s, window over which the odometry noise matcher (odometry_noise_matcher.h) learns the
   /// odometry's noise from the updates' innovations: the configured motion noise times a
-  /// learned factor (>= 1) per part, translation and rotation. 0 = the configured noise as it is.
-  double odometry_noise_window = 0.0;
+  /// learned factor (>= 1) per part, translation and rotation. 0 = the configured noise as it
+  /// is (the paper). KITTI raw (20 s, real OXTS): it learns the translation's variance 2-4x
+  /// and the rotation's ~2x the configured, all 12 within 3 sigma 88 -> 97 % of the pairs;
+  /// simulated drives whose odometry matches keep 1 after the start's first updates.
+  double odometry_noise_window = 20.0;
 
   // --- x_camr's drift rate as a state (issue 15) ---
   /// Steady-state 1 sigma (rad/s, per axis) of the rate at which x_camr's rotation drifts:

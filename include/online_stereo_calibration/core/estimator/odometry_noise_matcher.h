@@ -63,14 +63,20 @@ class OdometryNoiseMatcher {
   static constexpr double kFalseAlarm = 1e-3;
   /// Largest factor on the configured variance (10x the configured sigma).
   static constexpr double kMaxFactor = 100.0;
+  /// An update made while x_caml's rotation is known no better than this (rad, largest 1
+  /// sigma of its three angles) is linearised too far from the truth to speak of the
+  /// odometry: a campaign start 20 deg off (phase-0 run 90) read as a 10x noisier odometry
+  /// from its 4th update on, and the run went from honest to 570 frames beyond 5 sigma.
+  static constexpr double kSettledRotationSigma = 1.0 * 0.0174532925199432958;
 
   explicit OdometryNoiseMatcher(const OdometryNoiseMatcherOptions& options);
 
   /// Forgets the window and the learned factors.
   void reset();
   /// Advances the clock by dt (s) with one update's evidence (none: a step without update, or
-  /// the per-point motion model) and learns anew.
-  void addUpdate(double dt, const MotionNoiseEvidence* evidence);
+  /// the per-point motion model; not used while @p caml_rotation_sigma, x_caml's largest
+  /// rotation 1 sigma in rad, is above kSettledRotationSigma) and learns anew.
+  void addUpdate(double dt, const MotionNoiseEvidence* evidence, double caml_rotation_sigma);
   /// The factors for the filter's next prediction (CalibrationFilter::setMotionNoiseFactors).
   const std::array<double, 2>& factors() const { return status_.factor; }
   const OdometryNoiseStatus& status() const { return status_; }
