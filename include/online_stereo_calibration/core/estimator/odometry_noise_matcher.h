@@ -20,6 +20,14 @@
 /// The learned factor is max(1, k_p - z se_p) (z: the standard normal quantile of
 /// kFalseAlarm), at most kMaxFactor: the configured noise stays as it is until the window
 /// shows, beyond chance, that the odometry is noisier; the configured noise is a floor.
+/// The evidence is a linearised one: updates made while x_caml's rotation is still uncertain
+/// by more than kSettledRotationSigma are left out, and each update's T_p counts at most up to
+/// its chi-square bound at kFalseAlarm.
+///
+/// Measured: KITTI raw learns the rotation's variance ~4x (2x at the end) and the filter is
+/// within 3 sigma in 96 % of the pairs (88 % as configured); the simulated drives whose
+/// odometry is as configured keep the configured noise (docs/RESULTS.md "The odometry's noise,
+/// learned from the images").
 #pragma once
 
 #include <array>
