@@ -26,6 +26,7 @@ declare -A off=(
   [far_move_gate]="relinearization_far_threshold: 0"
   [tempering]="max_sigma_shrink_per_update: 0"
   [repeated_step_while_slow]="motion_relinearizations: 0"
+  [point_count_hold]="min_points_to_update: 0"
   [sustained_jump_test]="jump_sustained_frames: 0"
   [fitted_turn]="jump_fit_rotation_sigma_deg: 0"
   [gap_check]="unobserved_gap_s: 0"
@@ -41,7 +42,7 @@ odometry_forward_velocity_bias_sigma_mps: 0"
   [excitation]="motion_excitation_window_s: 0"
 )
 order=(hand_eye stereo_fit baseline_from_motion restart_from_estimate far_move_gate tempering
-  repeated_step_while_slow sustained_jump_test fitted_turn gap_check
+  repeated_step_while_slow point_count_hold sustained_jump_test fitted_turn gap_check
   epipolar_knock_test score_widening consistency_monitor time_offset_state
   read_odometry_at_offset velocity_error_states scale_in_sigmas camr_drift_rate excitation)
 

@@ -382,6 +382,62 @@ TEST(Start, TheBaselineFromMotionRestartsOnlyALengthTheFilterDoesNotKnow) {
   }
 }
 
+// Issue 14: a texture-poor view leaves a handful of tracked points. A pair with fewer than
+// min_points_to_update (5) of them is predicted, not updated: the calibration comes out as
+// from a pair without any point, the estimator says so once per stretch, and those points
+// start afresh as new ones. With the rule off, the same 3 points do move the calibration.
+TEST(FewPoints, APairWithFewerStereoPairsThanTheMinimumIsPredictedNotUpdated) {
+  MeasurementScenario scenario = paperOffroadScenario();
+  scenario.frames = 46;
+  scenario.step_frame = -1;
+  MeasurementSimulator simulator(scenario);
+  FilterConfig config;
+  ASSERT_EQ(config.min_points_to_update, 5);
+  StereoCalibrationEstimator held(config, scenario.left, scenario.right, simulator.initialGuess());
+  config.min_points_to_update = 0;
+  StereoCalibrationEstimator updated(config, scenario.left, scenario.right,
+                                     simulator.initialGuess());
+  SimulatedFrame frame;
+  std::string warnings;
+  while (simulator.nextFrame(&frame)) {
+    std::vector<StereoObservation> seen = frame.observations;
+    const bool texture_poor = frame.index == 40 || frame.index == 41;
+    if (texture_poor) {
+      // 3 of the points the filter tracks (in frame 41: the 3 that started afresh in 40).
+      seen.clear();
+      for (const StereoObservation& o : frame.observations) {
+        if (seen.size() < 3 && held.filter().hasPoint(o.id)) seen.push_back(o);
+      }
+      ASSERT_EQ(seen.size(), 3u);
+      StereoCalibrationEstimator held_blind = held, updated_blind = updated;
+      held_blind.processFrame(frame.measured_motion, {});
+      updated_blind.processFrame(frame.measured_motion, {});
+      const FrameReport a = held.processFrame(frame.measured_motion, seen);
+      const FrameReport b = updated.processFrame(frame.measured_motion, seen);
+      EXPECT_TRUE(a.too_few_points);
+      EXPECT_FALSE(b.too_few_points);
+      EXPECT_EQ(held.estimate().parameters, held_blind.estimate().parameters);
+      EXPECT_EQ(held.estimate().tangent_covariance, held_blind.estimate().tangent_covariance);
+      EXPECT_GT((updated.estimate().parameters - updated_blind.estimate().parameters).norm(), 1e-6)
+          << "without the rule the 3 points update the calibration";
+      EXPECT_EQ(a.new_points, 3) << "the 3 points start afresh";
+      for (const FrameEventLine& e : a.events) warnings += e.text + "\n";
+      continue;  // the simulator keeps every track: a texture-poor view is the filter's view
+    }
+    const FrameReport a = held.processFrame(frame.measured_motion, seen);
+    updated.processFrame(frame.measured_motion, seen);
+    simulator.dropTracks(a.dropped);
+    // Frame 42 tracks only the 3 restarted points, but its pair holds many new ones: it is
+    // updated (few tracked of many pairs is a start's thin evidence, not a texture-poor view).
+    EXPECT_FALSE(a.too_few_points) << "frame " << frame.index;
+  }
+  EXPECT_EQ(warnings.find("too few points: 3 stereo pairs, fewer than min_points_to_update 5"), 0u)
+      << warnings;
+  EXPECT_EQ(warnings.find("too few points", 1), std::string::npos) << "warned twice: " << warnings;
+  // Texture again: tracking and updates resumed.
+  EXPECT_GT(held.estimate().tracked_points, 20u);
+}
+
 // Gross outliers (wrong matches) must not drag the calibration.
 TEST(Robustness, FivePercentGrossOutliersDoNotDragTheCalibration) {
   MeasurementScenario scenario = paperOffroadScenario();

@@ -213,6 +213,10 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            "largest factor by which one update may shrink a calibration sigma; a larger "
            "shrink (a start or re-opening far off) is tempered and spread over frames; "
            "0 = off"),
+      integer("min_points_to_update", &C::min_points_to_update, 0, 100000, kPoints, kAdvanced,
+              "a pair with fewer stereo pairs than this (tracked and new) does not update the "
+              "calibration (the filter predicts; its points start afresh); 0 = update on any "
+              "point"),
       integer("baseline_from_motion", &C::baseline_from_motion, 0, 1, kStart, kAdvanced,
               "while no point can be initialised (a baseline guess far off), measure the "
               "baseline's length from the left camera's motion at the odometry's scale and "
@@ -419,6 +423,7 @@ FilterConfig paperFilterConfig() {
   config.epipolar_knock_false_alarm = 0.0;    // ... only
   config.relinearization_frames = 0;          // the paper's filter runs on from its start
   config.max_sigma_shrink_per_update = 0.0;   // ... and updates as the UKF does
+  config.min_points_to_update = 0;            // ... on however few points
   config.baseline_from_motion = 0;            // ... and the baseline from its points alone
   config.initial_time_offset_sigma = 0.0;     // the paper takes the odometry as synchronised
   config.odometry_scale_sigma = 0.0;          // ... and exact in scale

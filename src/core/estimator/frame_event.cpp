@@ -24,6 +24,8 @@ const char* frameEventName(FrameEvent kind) {
       return "right camera rotation from stereo fit";
     case FrameEvent::kBaselineFromMotion:
       return "baseline length from motion";
+    case FrameEvent::kTooFewPoints:
+      return "too few points to update";
     case FrameEvent::kNoPointInitialised:
       return "no point initialised";
     case FrameEvent::kNoPointMeasurable:

@@ -21,13 +21,6 @@ namespace {
 constexpr int kUnmeasurablePairsToWarn = 10;
 /// Fewest refused stereo pairs for which "no point could be initialised" is worth a warning.
 constexpr int kFewestPairsToExplain = 10;
-StereoIntrinsics stereoIntrinsics(const CameraModel& left, const CameraModel& right) {
-  StereoIntrinsics k;
-  k.K_left = left.K();
-  k.K_right = right.K();
-  return k;
-}
-
 HandEyeRotationConfig handEyeConfig(const FilterConfig& config) {
   HandEyeRotationConfig h;
   h.max_sigma = config.hand_eye_max_sigma;
@@ -45,7 +38,7 @@ StereoCalibrationEstimator::StereoCalibrationEstimator(const FilterConfig& confi
     : config_(config),
       left_(left),
       right_(right),
-      filter_(config, stereoIntrinsics(left_, right_)),
+      filter_(config, StereoIntrinsics{left_.K(), right_.K()}),
       restart_(RestartFromEstimateOptions::from(config)),
       jump_test_(JumpTestOptions::from(config)),
       score_test_(RightCameraScoreOptions::from(config)),
@@ -84,10 +77,10 @@ void StereoCalibrationEstimator::setFilterDriftInflation() {
 void StereoCalibrationEstimator::learnOdometryNoise(const MotionIncrement& motion,
                                                     FrameReport* report) {
   const std::string before = noise_matcher_.status().message();
-  const double caml_rotation_sigma = std::sqrt(std::max(
-      filter_.covariance().diagonal().segment<3>(layout::kCaml + layout::kRotation).maxCoeff(),
-      0.0));
-  noise_matcher_.addUpdate(motion.dt, filter_.lastMotionNoiseEvidence(), caml_rotation_sigma);
+  const double caml_rotation_variance =
+      filter_.covariance().diagonal().segment<3>(layout::kCaml + layout::kRotation).maxCoeff();
+  noise_matcher_.addUpdate(motion.dt, filter_.lastMotionNoiseEvidence(),
+                           std::sqrt(std::max(caml_rotation_variance, 0.0)));
   filter_.setMotionNoiseFactors(noise_matcher_.factors());
   const std::string after = noise_matcher_.status().message();
   if (before.empty() != after.empty()) {
@@ -194,24 +187,40 @@ FrameReport StereoCalibrationEstimator::processFrame(
   reopenIfOffEpipolarLines(&tracked, &candidates, &report);
 
   if (has_previous_frame_) {
+    // Too few points to update (a dim stretch of 1-4 points walked roll_l 1.9 -> 3.5 sigma
+    // off): predict only, those points start afresh. The new candidates count: few tracked of
+    // many pairs is a start's thin evidence (tempering's), not a texture-poor view.
+    const int needed = config_.min_points_to_update,
+              seen = static_cast<int>(tracked.size() + candidates.size());
+    report.too_few_points = !tracked.empty() && seen < needed;
+    if (report.too_few_points) {
+      if (!held_for_few_points_) {
+        report.events.add(FrameEvent::kTooFewPoints,
+                          "too few points: " + std::to_string(seen) +
+                              " stereo pairs, fewer than min_points_to_update " +
+                              std::to_string(needed) +
+                              "; the calibration is kept, not updated, until more are seen");
+      }
+      candidates.insert(candidates.end(), tracked.begin(), tracked.end());
+      tracked.clear();
+    }
+    held_for_few_points_ = report.too_few_points;
     gap_check_.beforeStep(&monitor_, !tracked.empty());
     report.step = filter_.step(motion, tracked, [this](const GateOutcome& gate) {
       return jump_test_.decide(gate, filter_);
     });
     gap_check_.countAfterStep(motion, report.step);
-    if (report.step.accepted) {
-      followFilter();  // a jump's re-opening ends the monitor's window before its update
-      monitor_.addUpdate(motion.dt, filter_.lastUpdateScores());
-      report.consistency = monitor_.status();
-      setFilterDriftInflation();
-      learnOdometryNoise(motion, &report);
-    }
     if (!report.step.accepted) {
       // Without a usable motion the points cannot be predicted: start tracking afresh.
       report.events.add(FrameEvent::kMotionRejected, "motion rejected: " + report.step.message);
       report.dropped = resetTracking();
       candidates.insert(candidates.end(), tracked.begin(), tracked.end());
     } else {
+      followFilter();  // a jump's re-opening ends the monitor's window before its update
+      monitor_.addUpdate(motion.dt, filter_.lastUpdateScores());
+      report.consistency = monitor_.status();
+      setFilterDriftInflation();
+      learnOdometryNoise(motion, &report);
       report.dropped = report.step.lost;
       report.dropped.insert(report.dropped.end(), report.step.outliers.begin(),
                             report.step.outliers.end());
@@ -427,6 +436,7 @@ void StereoCalibrationEstimator::warnIfNoPointMeasurable(
 
 void StereoCalibrationEstimator::forgetDriveEvidence() {
   baseline_restart_.forget();
+  held_for_few_points_ = false;
   unmeasurable_pairs_ = 0;
   knock_test_.reset();
   mounting_.clear();

@@ -21,6 +21,7 @@ enum class FrameEvent {
   kMountingRotationFromMotion,   ///< the hand-eye start restarted x_caml's rotation
   kRightRotationFromStereoFit,   ///< the stereo fit re-seeded x_camr (CalibrationPipeline)
   kBaselineFromMotion,           ///< x_camr's translation restarted at the measured length
+  kTooFewPoints,                 ///< a stretch of pairs too few to update begins (predicted only)
   kNoPointInitialised,           ///< stereo pairs came, none triangulates: the baseline guess?
   kNoPointMeasurable,            ///< tracked points measured, none predictable, for 10 pairs
   kCovarianceRepaired,           ///< the calibration covariance had to be made positive definite

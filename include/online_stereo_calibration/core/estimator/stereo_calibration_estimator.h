@@ -78,6 +78,10 @@ struct FrameReport {
   int invalid_observations = 0;  ///< non-finite pixels or sigmas
   /// Points no longer in the filter (lost, outliers, reset): a tracker should forget them.
   std::vector<PointId> dropped;
+  /// Fewer stereo pairs (tracked and new) than FilterConfig::min_points_to_update: the
+  /// calibration was predicted, not updated, and the tracked points start afresh (the
+  /// event kTooFewPoints is given in the first such pair of a stretch).
+  bool too_few_points = false;
 
   bool has(FrameEvent kind) const { return events.has(kind); }
 };
@@ -204,6 +208,8 @@ class StereoCalibrationEstimator {
   CameraModel right_;
   CalibrationFilter filter_;
   bool has_previous_frame_ = false;
+  /// The last pair had too few stereo pairs to update (FrameReport::too_few_points).
+  bool held_for_few_points_ = false;
   /// Pairs in a row whose tracked points were all measured and none predictable
   /// (FrameEvent::kNoPointMeasurable).
   int unmeasurable_pairs_ = 0;
