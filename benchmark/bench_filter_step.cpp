@@ -6,9 +6,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include "online_stereo_calibration/core/estimator/consistency_monitor.h"
 #include "online_stereo_calibration/core/estimator/jump_test.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
-#include "online_stereo_calibration/core/filter/consistency_monitor.h"
 #include "online_stereo_calibration/core/filter/dense_calibration_ukf.h"
 
 namespace osc {

@@ -30,7 +30,7 @@ const char* stateName(uint8_t state) {
   return "UNKNOWN";
 }
 
-/// The consistency monitor (core/filter/consistency_monitor.h): each block's window
+/// The consistency monitor (core/estimator/consistency_monitor.h): each block's window
 /// statistic per degree of freedom against its bound, the drift-noise factors, and a WARN
 /// while it raises a block's process noise.
 void addConsistency(const osc::ConsistencyStatus& consistency,

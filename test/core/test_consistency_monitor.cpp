@@ -13,7 +13,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
-#include "online_stereo_calibration/core/filter/consistency_monitor.h"
+#include "online_stereo_calibration/core/estimator/consistency_monitor.h"
 #include "online_stereo_calibration/core/sim/measurement_simulator.h"
 #include "online_stereo_calibration/core/sim/scenario_runner.h"
 

@@ -8,7 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
-#include "online_stereo_calibration/core/filter/consistency_monitor.h"
+#include "online_stereo_calibration/core/estimator/consistency_monitor.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/geometry/stereo_geometry.h"
 

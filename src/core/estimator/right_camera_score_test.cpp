@@ -5,7 +5,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "online_stereo_calibration/core/filter/consistency_monitor.h"
+#include "online_stereo_calibration/core/estimator/consistency_monitor.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 
 namespace osc {

@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "online_stereo_calibration/core/config/filter_config.h"
+#include "online_stereo_calibration/core/estimator/consistency_monitor.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
-#include "online_stereo_calibration/core/filter/consistency_monitor.h"
 
 namespace osc {
 

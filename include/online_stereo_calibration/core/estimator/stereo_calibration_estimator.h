@@ -15,6 +15,7 @@
 
 #include "online_stereo_calibration/core/config/filter_config.h"
 #include "online_stereo_calibration/core/estimator/baseline_restart.h"
+#include "online_stereo_calibration/core/estimator/consistency_monitor.h"
 #include "online_stereo_calibration/core/estimator/epipolar_consistency.h"
 #include "online_stereo_calibration/core/estimator/frame_event.h"
 #include "online_stereo_calibration/core/estimator/jump_test.h"
@@ -25,7 +26,6 @@
 #include "online_stereo_calibration/core/estimator/right_camera_score_test.h"
 #include "online_stereo_calibration/core/estimator/types.h"
 #include "online_stereo_calibration/core/filter/calibration_filter.h"
-#include "online_stereo_calibration/core/filter/consistency_monitor.h"
 #include "online_stereo_calibration/core/geometry/camera_model.h"
 #include "online_stereo_calibration/core/geometry/pose.h"
 

@@ -1,4 +1,4 @@
-#include "online_stereo_calibration/core/filter/consistency_monitor.h"
+#include "online_stereo_calibration/core/estimator/consistency_monitor.h"
 
 #include <algorithm>
 #include <cmath>
