@@ -48,7 +48,14 @@ void OdometryNoiseMatcher::addUpdate(double dt, const MotionNoiseEvidence* evide
   if (!status_.enabled) return;
   time_ += dt;
   if (evidence && caml_rotation_sigma <= kSettledRotationSigma) {
-    window_entries_.push_back({time_, *evidence});
+    // One update's statistic counts at most up to its chi-square bound: a few updates
+    // linearised far off (a start 20 deg off) do not make a noisy odometry on their own.
+    Entry entry{time_, *evidence};
+    for (int p = 0; p < 2; ++p) {
+      entry.evidence.statistic[p] = std::min(
+          entry.evidence.statistic[p], chiSquareUpperQuantile(entry.evidence.dof[p], kFalseAlarm));
+    }
+    window_entries_.push_back(entry);
   }
   while (!window_entries_.empty() && window_entries_.front().time <= time_ - options_.window) {
     window_entries_.pop_front();
@@ -57,17 +64,14 @@ void OdometryNoiseMatcher::addUpdate(double dt, const MotionNoiseEvidence* evide
 }
 
 void OdometryNoiseMatcher::learn() {
-  const double z = normalUpperQuantile(kFalseAlarm);
+  static const double z = normalUpperQuantile(kFalseAlarm);
   const std::array<double, 2> configured = {options_.translation_noise, options_.rotation_noise};
   status_.window_updates = static_cast<int>(window_entries_.size());
   for (int p = 0; p < 2; ++p) {
     double excess = 0.0, dof = 0.0, growth = 0.0;
     for (const Entry& entry : window_entries_) {
       const MotionNoiseEvidence& e = entry.evidence;
-      // One update's statistic counts at most up to its chi-square bound: a few updates
-      // linearised far off (a start 20 deg off) do not make a noisy odometry on their own.
-      const double bound = chiSquareUpperQuantile(e.dof[p], kFalseAlarm);
-      excess += std::min(e.statistic[p], bound) - e.dof[p] + e.applied_factor[p] * e.growth[p];
+      excess += e.statistic[p] - e.dof[p] + e.applied_factor[p] * e.growth[p];
       dof += e.dof[p];
       growth += e.growth[p];
     }
