@@ -45,7 +45,7 @@ void addConsistency(const osc::ConsistencyStatus& consistency,
                 value.str());
   }
   std::ostringstream factors;
-  factors << consistency.inflation[0] << ", " << consistency.inflation[1];
+  factors << consistency.inflation.caml << ", " << consistency.inflation.camr;
   status->add("drift noise factor (x_caml, x_camr)", factors.str());
   const std::string message = consistency.message();
   status->add("consistency", message.empty() ? "measurements agree with the model" : message);

@@ -155,7 +155,6 @@ TEST(ConsistencyScores, PartialShiftEstimateRecoversTheShiftedBlock) {
 FilterConfig monitorConfig() {
   FilterConfig config;
   config.consistency_window = 4.0;
-  config.consistency_startup = 0.0;
   config.consistency_false_alarm = 0.01;
   config.max_drift_inflation = 100.0;
   config.drift_inflation_decade = 2.0;
@@ -191,7 +190,7 @@ TEST(ConsistencyMonitor, ConsistentUpdatesStayWithinTheBand) {
   for (int b = 0; b < 3; ++b) EXPECT_NEAR(sum[b] / dof[b], 1.0, 4.0 * std::sqrt(2.0 / dof[b]));
   // Three tests at 1 % each; windows overlap, so the share scatters more than binomially.
   EXPECT_LT(exceeded, 0.06 * updates);
-  EXPECT_LT(monitor.status().inflation[kCamr], 100.0);
+  EXPECT_LT(monitor.inflation().camr, 100.0);
 }
 
 // x_camr shifted beyond its prior: its statistic exceeds within a few updates, x_caml's
@@ -218,8 +217,8 @@ TEST(ConsistencyMonitor, ShiftedBlockTriggersIsAttributedAndRelaxes) {
   ASSERT_GE(first_exceeded, 0);
   EXPECT_LT(first_exceeded, 10);
   EXPECT_LT(caml_exceeded, 5);
-  EXPECT_NEAR(monitor.inflation(ConsistencyBlock::kLeftToRight), 100.0, 1e-6);
-  EXPECT_LT(monitor.inflation(ConsistencyBlock::kVehicleToLeft), 2.0);
+  EXPECT_NEAR(monitor.inflation().camr, 100.0, 1e-6);
+  EXPECT_LT(monitor.inflation().caml, 2.0);
   EXPECT_EQ(monitor.status().message(),
             "measurements disagree with the model: process noise raised on x_camr");
   // Consistent again: the window empties of the shift, then the factor relaxes (tau 10 s).
@@ -227,8 +226,8 @@ TEST(ConsistencyMonitor, ShiftedBlockTriggersIsAttributedAndRelaxes) {
     const UpdateScores s = u.draw(&rng, VectorXd::Zero(u.G));
     monitor.addUpdate(0.1, &s);
   }
-  EXPECT_LT(monitor.inflation(ConsistencyBlock::kLeftToRight), 1.3);
-  EXPECT_GT(monitor.inflation(ConsistencyBlock::kLeftToRight), 1.0);
+  EXPECT_LT(monitor.inflation().camr, 1.3);
+  EXPECT_GT(monitor.inflation().camr, 1.0);
   EXPECT_FALSE(monitor.status().acting());
   EXPECT_EQ(monitor.status().message(), "");
 }
@@ -251,54 +250,48 @@ TEST(ConsistencyMonitor, CommonNoiseExcessDoesNotRaiseTheCalibration) {
   EXPECT_LT(acting, 15);
 }
 
-// After a reset x_caml is only reported for consistency_startup_s; x_camr is acted on at once.
-TEST(ConsistencyMonitor, HoldsTheVehicleToLeftBlockDuringStartUp) {
+// After a reset both calibration blocks are acted on at once: a mounting that turns from the
+// start is followed from the start.
+TEST(ConsistencyMonitor, ActsOnBothBlocksFromTheStart) {
   std::mt19937 rng(19);
   const SyntheticUpdate u(&rng);
-  FilterConfig config = monitorConfig();
-  config.consistency_startup = 5.0;
-  ConsistencyMonitor monitor(config);
+  ConsistencyMonitor monitor(monitorConfig());
   VectorXd shift = VectorXd::Zero(u.G);
   shift.head<12>() = 2.0 * u.P.diagonal().head<12>().cwiseSqrt();  // both blocks 2 sigma off
   int camr_first = -1, caml_first = -1;
-  for (int k = 0; k < 100; ++k) {
+  for (int k = 0; k < 30; ++k) {
     const UpdateScores s = u.draw(&rng, shift);
     monitor.addUpdate(0.1, &s);
-    if (camr_first < 0 && monitor.status().acting(ConsistencyBlock::kLeftToRight)) camr_first = k;
-    if (caml_first < 0 && monitor.status().acting(ConsistencyBlock::kVehicleToLeft)) caml_first = k;
+    if (camr_first < 0 && monitor.inflation().camr > 1.0) camr_first = k;
+    if (caml_first < 0 && monitor.inflation().caml > 1.0) caml_first = k;
   }
   EXPECT_GE(camr_first, 0);
   EXPECT_LT(camr_first, 10);
-  EXPECT_GE(caml_first, 49);  // 5 s at 10 Hz
-  EXPECT_LT(caml_first, 60);
-  EXPECT_GT(monitor.inflation(ConsistencyBlock::kVehicleToLeft), 1.0);
+  EXPECT_GE(caml_first, 0);
+  EXPECT_LT(caml_first, 10);
+  EXPECT_EQ(monitor.status().message(),
+            "measurements disagree with the model: process noise raised on x_caml and x_camr");
 }
 
-// forgetEvidence empties the window, so a shift seen after it is judged on its own updates,
-// and unlike clearWindow it does not restart the start-up hold.
-TEST(ConsistencyMonitor, ForgettingTheEvidenceKeepsTheHoldAndTheFactors) {
+// forgetEvidence empties the window, so a shift seen after it is judged on its own updates;
+// the factors it drove are kept.
+TEST(ConsistencyMonitor, ForgettingTheEvidenceKeepsTheFactors) {
   std::mt19937 rng(23);
   const SyntheticUpdate u(&rng);
-  FilterConfig config = monitorConfig();
-  config.consistency_startup = 5.0;
-  ConsistencyMonitor monitor(config);
+  ConsistencyMonitor monitor(monitorConfig());
   VectorXd shift = VectorXd::Zero(u.G);
   shift.segment<6>(6) = 2.0 * u.P.diagonal().segment<6>(6).cwiseSqrt();  // x_camr 2 sigma off
-  for (int k = 0; k < 60; ++k) {  // 6 s: past the hold, x_camr's factor raised
+  for (int k = 0; k < 60; ++k) {  // 6 s: x_camr's factor raised
     const UpdateScores s = u.draw(&rng, shift);
     monitor.addUpdate(0.1, &s);
   }
-  ASSERT_FALSE(monitor.status().holding);
   ASSERT_TRUE(monitor.status().exceeded[kCamr]);
-  const double factor = monitor.inflation(ConsistencyBlock::kLeftToRight);
+  const double factor = monitor.inflation().camr;
   ASSERT_GT(factor, 10.0);
   monitor.forgetEvidence();
   EXPECT_EQ(monitor.status().window_updates, 0);
   EXPECT_FALSE(monitor.status().exceeded[kCamr]);
-  EXPECT_FALSE(monitor.status().holding);
-  EXPECT_DOUBLE_EQ(monitor.inflation(ConsistencyBlock::kLeftToRight), factor);
-  monitor.clearWindow();  // a re-opened block, by contrast, holds x_caml again
-  EXPECT_TRUE(monitor.status().holding);
+  EXPECT_DOUBLE_EQ(monitor.inflation().camr, factor);
 }
 
 TEST(ConsistencyMonitor, OffDoesNothing) {
@@ -313,7 +306,7 @@ TEST(ConsistencyMonitor, OffDoesNothing) {
   for (int k = 0; k < 100; ++k) monitor.addUpdate(0.1, &s);
   EXPECT_FALSE(monitor.status().enabled);
   EXPECT_FALSE(monitor.status().acting());
-  EXPECT_EQ(monitor.inflation(ConsistencyBlock::kLeftToRight), 1.0);
+  EXPECT_EQ(monitor.inflation().camr, 1.0);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -415,6 +408,35 @@ TEST(ConsistencyScenario, FastRightCameraDriftIsFollowedHonestly) {
   EXPECT_GE(after.within2(11), before.within2(11) + 0.1);  // yaw_r
   EXPECT_GT(after.acting, 0.0);
   EXPECT_EQ(before.acting, 0.0);
+}
+
+// The mounting itself turning from the start, at the rate of issue 57's car drive (pitch_l
+// 4.5 deg/min, yaw_l -6 deg/min): the monitor raises x_caml's noise from its first updates
+// (it used to hold x_caml for 20 s after a start, and the rendered drive reached yaw_l
+// 8.2 sigma, docs/RESULTS.md). Measured, seed 1, frames 30-399: without the monitor all 12
+// within 3 sigma in 2 % of the frames, 74 % beyond 5 sigma, largest error 17 sigma; with it
+// 69 %, none beyond 5, largest 4.3 sigma.
+TEST(ConsistencyScenario, LeftCameraTurningFromTheStartIsFollowed) {
+  MeasurementScenario scenario = paperOffroadScenario();
+  scenario.name = "caml_ramp";
+  scenario.step_frame = -1;
+  scenario.frames = 400;
+  scenario.drift_per_second.setZero();
+  scenario.drift_per_second(4) = 4.5 * kDeg / 60.0;   // pitch_l
+  scenario.drift_per_second(5) = -6.0 * kDeg / 60.0;  // yaw_l
+  FilterConfig off;
+  off.consistency_window = 0.0;
+  const RunFigures before = run(scenario, off, 250, 399);
+  const RunFigures after = run(scenario, FilterConfig(), 250, 399);
+  std::cout << "all 12 within 3 sigma from frame 30: " << before.all_within3 << " -> "
+            << after.all_within3 << ", beyond 5: " << before.beyond5 << " -> " << after.beyond5
+            << ", largest |error| / sigma " << before.max_ratio << " -> " << after.max_ratio
+            << "\n";
+  EXPECT_GT(before.beyond5, 0.5);  // the ramp is far faster than the configured walk
+  EXPECT_EQ(after.beyond5, 0.0);
+  EXPECT_LT(after.max_ratio, 5.0);
+  EXPECT_GE(after.all_within3, 0.6);
+  EXPECT_GT(after.acting, 0.0);
 }
 
 // The same drift with x_camr's drift rate as a state and no monitor: followed without a lag

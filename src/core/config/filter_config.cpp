@@ -280,10 +280,6 @@ const std::vector<ParameterSpec>& filterParameterTable() {
            kAdvanced,
            "window of the per-block score test of the updates' consistency (0 = off, as the "
            "paper; consistency_monitor.h)"),
-      real("consistency_startup_s", &C::consistency_startup, 1.0, 0.0, 1e6, kConsistencyMonitor,
-           kAdvanced,
-           "after a reset or a re-opened block the monitor reports but does not act on x_caml "
-           "this long"),
       real("consistency_false_alarm", &C::consistency_false_alarm, 1.0, 1e-9, 0.5,
            kConsistencyMonitor, kAdvanced,
            "probability that a consistent filter's window statistic exceeds its chi-square bound"),

@@ -73,24 +73,16 @@ ConsistencyMonitor::ConsistencyMonitor(const FilterConfig& config)
       max_log_inflation_(std::log(std::max(config.max_drift_inflation, 1.0))),
       log_rate_(config.drift_inflation_decade > 0.0 ? std::log(10.0) / config.drift_inflation_decade
                                                     : 0.0),
-      relax_time_(config.drift_inflation_relax),
-      startup_(config.consistency_startup) {
+      relax_time_(config.drift_inflation_relax) {
   reset();
 }
 
 void ConsistencyMonitor::reset() {
   time_ = 0.0;
-  hold_until_ = startup_;
   window_entries_.clear();
   log_inflation_ = {0.0, 0.0};
   status_ = ConsistencyStatus();
   status_.enabled = enabled_;
-}
-
-void ConsistencyMonitor::clearWindow() {
-  window_entries_.clear();
-  hold_until_ = time_ + startup_;
-  evaluate();
 }
 
 void ConsistencyMonitor::forgetEvidence() {
@@ -113,8 +105,9 @@ void ConsistencyMonitor::addUpdate(double dt, const UpdateScores* scores) {
     } else {
       log_inflation_[k] *= relax_time_ > 0.0 ? std::exp(-dt / relax_time_) : 0.0;
     }
-    status_.inflation[k] = std::exp(log_inflation_[k]);
   }
+  status_.inflation.caml = std::exp(log_inflation_[0]);
+  status_.inflation.camr = std::exp(log_inflation_[1]);
 }
 
 void ConsistencyMonitor::evaluate() {
@@ -128,7 +121,6 @@ void ConsistencyMonitor::evaluate() {
     rest_dof += entry.scores.rest_dof;
   }
   status_.window_updates = static_cast<int>(window_entries_.size());
-  status_.holding = time_ < hold_until_;
   std::array<double, 2> statistic = {0.0, 0.0};
   std::array<int, 2> dof = {0, 0};
   if (!window_entries_.empty()) calibrationStatistics(score, information, &statistic, &dof);
@@ -146,11 +138,6 @@ void ConsistencyMonitor::evaluate() {
   for (int k = 0; k < kConsistencyBlocks; ++k) {
     status_.exceeded[k] = dofs[k] > 0.0 && status_.statistic[k] > status_.bound[k];
   }
-}
-
-double ConsistencyMonitor::inflation(ConsistencyBlock block) const {
-  const int k = static_cast<int>(block);
-  return k < 2 ? status_.inflation[k] : 1.0;
 }
 
 }  // namespace osc

@@ -62,7 +62,7 @@ void StereoCalibrationEstimator::followFilter() {
     monitor_.reset();
   } else if (filter_.reopenings() != monitor_reopenings_) {
     monitor_reopenings_ = filter_.reopenings();
-    monitor_.clearWindow();  // the evidence was the re-opened block's old calibration
+    monitor_.forgetEvidence();  // the evidence was the re-opened block's old calibration
   }
   setFilterDriftInflation();
 }
@@ -70,8 +70,7 @@ void StereoCalibrationEstimator::followFilter() {
 void StereoCalibrationEstimator::setFilterDriftInflation() {
   // Set as soon as the monitor changes: the front end's predictObservations before the next
   // step predicts with them, and the step reuses that prediction.
-  filter_.setDriftInflation({monitor_.inflation(ConsistencyBlock::kVehicleToLeft),
-                             monitor_.inflation(ConsistencyBlock::kLeftToRight)});
+  filter_.setDriftInflation(monitor_.inflation());
 }
 
 void StereoCalibrationEstimator::learnOdometryNoise(const MotionIncrement& motion,

@@ -61,8 +61,8 @@ void CalibrationFilter::applyCalibrationDrift(double dt) {
   // monitor's factor per block (1 unless the block's measurements disagree).
   MatrixXd drift = MatrixXd::Zero(persistentDim(), persistentDim());
   drift.topLeftCorner<12, 12>() = calibrationDriftCovariance(config_, dt);
-  drift.block<6, 6>(layout::kCaml, layout::kCaml) *= drift_inflation_[0];
-  drift.block<6, 6>(layout::kCamr, layout::kCamr) *= drift_inflation_[1];
+  drift.block<6, 6>(layout::kCaml, layout::kCaml) *= drift_inflation_.caml;
+  drift.block<6, 6>(layout::kCamr, layout::kCamr) *= drift_inflation_.camr;
   if (time_offset_index_ >= 0)
     drift(time_offset_index_, time_offset_index_) =
         std::pow(config_.time_offset_drift, 2) * noiseScale(config_, dt);

@@ -314,9 +314,6 @@ struct FilterConfig {
   // --- consistency monitor and adaptive drift noise (consistency_monitor.h) ---
   /// Sliding window (s) of the per-block score test of the updates; 0 = off (the paper).
   double consistency_window = 4.0;
-  /// s after a reset or a re-opened block during which the monitor reports but does not act
-  /// on x_caml (consistency_monitor.h says why).
-  double consistency_startup = 20.0;
   /// Probability that a consistent filter's window statistic exceeds its bound (per test).
   double consistency_false_alarm = 1e-3;
   /// Largest factor on the variance of a block's random walk (eq. 10-13).

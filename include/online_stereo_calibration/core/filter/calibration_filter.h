@@ -29,6 +29,7 @@
 #include "online_stereo_calibration/core/filter/measurement_model.h"
 #include "online_stereo_calibration/core/filter/motion_excitation.h"
 #include "online_stereo_calibration/core/filter/point_coordinates.h"
+#include "online_stereo_calibration/core/filter/process_model.h"
 #include "online_stereo_calibration/core/filter/state_layout.h"
 #include "online_stereo_calibration/core/filter/unscented_transform.h"
 #include "online_stereo_calibration/core/filter/update_scores.h"
@@ -187,10 +188,10 @@ class CalibrationFilter {
   /// How many times a block was re-opened (reopen, or a change detector's verdict in a step):
   /// a component whose evidence a re-opening ends (the consistency monitor) compares it.
   int reopenings() const { return reopenings_; }
-  /// The factors on x_caml's and x_camr's random walk (eq. 10-13) from the next prediction
-  /// on (the consistency monitor's; 1 = as configured). A prediction kept by
+  /// The factors on the calibration's random walk (eq. 10-13) from the next prediction on
+  /// (the consistency monitor's; 1 = as configured). A prediction kept by
   /// predictObservations with other factors is dropped.
-  void setDriftInflation(const std::array<double, 2>& factors) {
+  void setDriftInflation(const DriftInflation& factors) {
     if (factors == drift_inflation_) return;
     drift_inflation_ = factors;
     last_prediction_.reset();
@@ -339,8 +340,8 @@ class CalibrationFilter {
   /// Starts so far (startCalibration) and re-openings (reopen, applyReopening).
   int starts_ = 0;
   int reopenings_ = 0;
-  /// Factors on x_caml's and x_camr's random walk (setDriftInflation).
-  std::array<double, 2> drift_inflation_ = {1.0, 1.0};
+  /// Factors on the calibration's random walk (setDriftInflation).
+  DriftInflation drift_inflation_;
   std::array<double, 2> motion_noise_factors_ = {1.0, 1.0};
   PointCoordinates coordinates_;  ///< how TrackedPoint::mean stores a point
   UnscentedParameters ut_;

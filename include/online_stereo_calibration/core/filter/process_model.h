@@ -87,6 +87,14 @@ double noiseScale(const FilterConfig& config, double dt);
 /// Seed eq. 10-13: calibration drift covariance over dt, in the filter's error layout.
 Matrix12d calibrationDriftCovariance(const FilterConfig& config, double dt);
 
+/// Factors on the variance of the calibration's random walk (eq. 10-13) per block; 1 = as
+/// configured. The consistency monitor's (consistency_monitor.h) for the filter's prediction.
+struct DriftInflation {
+  double caml = 1.0;  ///< x_caml
+  double camr = 1.0;  ///< x_camr
+  bool operator==(const DriftInflation& o) const { return caml == o.caml && camr == o.camr; }
+};
+
 /// Covariance of the error of one measured motion increment [dt (3), dtheta (3)] over dt
 /// (shared motion-noise model; eq. 15 for the rotation).
 Matrix6d motionNoiseCovariance(const FilterConfig& config, double dt);
