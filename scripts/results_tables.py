@@ -86,31 +86,48 @@ def rmse_table(directories, first, last):
     print("| ours / paper | %s |" % ratio)
 
 
+def honest_runs(directory):
+    """{run: honest?} of a campaign directory (a failed run is not honest)."""
+    with open(os.path.join(directory, "campaign.csv")) as f:
+        return {r["run"]: r["status"] == "ok" and float(r["share_within_3sigma"]) >= 0.95
+                and int(r["frames_beyond_5sigma"]) == 0 for r in csv.DictReader(f)}
+
+
 def campaign_counts(directory):
     """(honest runs, runs, frames beyond 5 sigma) of a campaign directory."""
     with open(os.path.join(directory, "campaign.csv")) as f:
         rows = list(csv.DictReader(f))
-    honest = sum(1 for r in rows if r["status"] == "ok" and float(r["share_within_3sigma"]) >= 0.95
-                 and int(r["frames_beyond_5sigma"]) == 0)
+    honest = sum(honest_runs(directory).values())
     beyond = sum(int(r["frames_beyond_5sigma"]) for r in rows if r["status"] == "ok")
     return honest, len(rows), beyond
 
 
 def ablation_table(directory, variants, first=1000, last=1150):
-    """One row per variant of scripts/ablation.sh; RMSE relative to `shipped`."""
+    """One row per variant of scripts/ablation.sh; RMSE relative to `shipped`. A variant on
+    the same runs as `shipped` (not `noise`) also shows, paired, the runs it made dishonest
+    and honest: both 0 when switching the mechanism off changes no run's verdict."""
     def seeds(variant):
         root = os.path.join(directory, variant, "po")
         return [os.path.join(root, d) for d in sorted(os.listdir(root))]
 
     shipped = pooled_rmse(seeds("shipped"), first, last)
-    print("| switched off | drawn: honest / frames > 5σ | phase-0: honest / frames > 5σ "
+    print("| switched off | drawn: honest (lost, gained) / frames > 5σ "
+          "| phase-0: honest (lost, gained) / frames > 5σ "
           "| paper_offroad RMSE / shipped: largest (parameter) | pitch_l |")
     print("|---|---|---|---|---|")
     for variant in variants:
         cells = []
         for campaign in ("drawn", "phase0"):
-            honest, runs, beyond = campaign_counts(os.path.join(directory, variant, campaign))
-            cells.append("%d of %d / %d" % (honest, runs, beyond))
+            path = os.path.join(directory, variant, campaign)
+            honest, runs, beyond = campaign_counts(path)
+            paired = ""
+            if variant not in ("shipped", "noise"):
+                base = honest_runs(os.path.join(directory, "shipped", campaign))
+                mine = honest_runs(path)
+                lost = sum(1 for k, v in base.items() if v and not mine.get(k, False))
+                gained = sum(1 for k, v in mine.items() if v and not base.get(k, False))
+                paired = " (-%d, +%d)" % (lost, gained)
+            cells.append("%d of %d%s / %d" % (honest, runs, paired, beyond))
         ratio = pooled_rmse(seeds(variant), first, last) / shipped
         largest = int(np.argmax(np.abs(np.log(ratio))))
         label = {"shipped": "nothing (shipped)",
