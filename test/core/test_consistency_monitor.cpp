@@ -81,7 +81,7 @@ struct SyntheticUpdate {
     }
     if (r_out) *r_out = r;
     const MatrixXd P_post = (P.inverse() + A).inverse();
-    return computeUpdateScores(A, b, c, P_post, 4 * N);
+    return computeUpdateScores(globalScore(A, b, P_post), b, c, 4 * N);
   }
 };
 

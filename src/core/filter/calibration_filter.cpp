@@ -342,12 +342,13 @@ bool CalibrationFilter::runPass(const MotionIncrement& motion, const Vector6d& p
   }
   P = 0.5 * (P + P.transpose());
   if (monitored) {
-    scores_ = computeUpdateScores(information, score, residual_norm, P,
+    const GlobalScore global = globalScore(information, score, P);
+    scores_ = computeUpdateScores(global, score, residual_norm,
                                   layout::kMeasurementDim * static_cast<int>(used.size()));
     has_scores_ = true;
     if (shared) {
-      motion_evidence_ = motionNoiseEvidence(globalScore(information, score, P),
-                                             configuredMotionNoise(motion), motion_noise_factors_);
+      motion_evidence_ =
+          motionNoiseEvidence(global, configuredMotionNoise(motion), motion_noise_factors_);
       has_motion_evidence_ = true;
     }
   }

@@ -98,12 +98,10 @@ GlobalScore globalScore(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
   return global;
 }
 
-UpdateScores computeUpdateScores(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
-                                 double residual_norm, const Eigen::MatrixXd& P_post,
-                                 int measurement_dof) {
+UpdateScores computeUpdateScores(const GlobalScore& global, const Eigen::VectorXd& b,
+                                 double residual_norm, int measurement_dof) {
   UpdateScores scores;
-  const int G = static_cast<int>(A.rows());
-  const GlobalScore global = globalScore(A, b, P_post);
+  const int G = static_cast<int>(b.size());
   const Eigen::VectorXd& g = global.score;
   const Eigen::MatrixXd& F = global.information;
   scores.score = g.head<12>();

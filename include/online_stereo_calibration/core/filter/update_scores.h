@@ -64,11 +64,12 @@ struct UpdateScores {
 
 /// The evidence of one linearised update. The global error has G dimensions with x_caml at 0,
 /// x_camr at 6 (state_layout.h).
+/// @param global globalScore(A, b, P+) of the update
+/// @param score b = sum J_i^T S0_i^-1 r_i (G)
 /// @param residual_norm sum r_i^T S0_i^-1 r_i
 /// @param measurement_dof 4 N
-UpdateScores computeUpdateScores(const Eigen::MatrixXd& information, const Eigen::VectorXd& score,
-                                 double residual_norm, const Eigen::MatrixXd& posterior_covariance,
-                                 int measurement_dof);
+UpdateScores computeUpdateScores(const GlobalScore& global, const Eigen::VectorXd& score,
+                                 double residual_norm, int measurement_dof);
 
 /// One update's evidence on the step's motion error e (the last 6 entries of the global error:
 /// translation, then rotation), per part p (0 translation, 1 rotation), with every other entry
