@@ -340,11 +340,14 @@ BaselineStart runBaselineStart(double truth_length, double guess_length, int fra
   return run;
 }
 
-// Issue "Real drives in": an 11 cm rig guessed at 1 cm. No point passes the depth check with
-// the guess, so the length is measured from the left camera's motion and x_camr restarted at
-// it by pair 50; from 30 pairs after the start all 12 errors within 3 sigma in >= 95 % of the
-// pairs, none beyond 5. (Seeds 1-5: DISABLED_BaselineGuessReport.)
-TEST(BaselineStart, ElevenCentimetreRigGuessedAtOneCentimetreStartsByPair50AndIsHonest) {
+// Issue "Real drives in": an 11 cm rig guessed at 1 cm. No point can be initialised with the
+// guess, so the length is measured from the left camera's motion and x_camr restarted at it;
+// from 30 pairs after the start all 12 errors within 3 sigma in >= 95 % of the pairs, none
+// beyond 5. Measured: started at pair 6, since the front end keeps the pairs whose depth is
+// in range for some length within 3 sigma while the filter holds no point (31 when the 1 cm
+// length alone judged them and few far points fed the fit). (Seeds 1-5:
+// DISABLED_BaselineGuessReport.)
+TEST(BaselineStart, ElevenCentimetreRigGuessedAtOneCentimetreStartsWithin15PairsAndIsHonest) {
   const BaselineStart run = runBaselineStart(0.11, 0.01, 90, 1);
   std::cout << "11 cm guessed 1 cm: restarted at " << run.restarted_at << ", started at "
             << run.started_at << " (" << run.fits_without_points << " whole-image fits in "
@@ -353,7 +356,7 @@ TEST(BaselineStart, ElevenCentimetreRigGuessedAtOneCentimetreStartsByPair50AndIs
             << run.length << " +- " << run.length_sigma << " m\n";
   EXPECT_GE(run.restarted_at, 0);
   EXPECT_GE(run.started_at, 0);
-  EXPECT_LE(run.started_at, 50);
+  EXPECT_LE(run.started_at, 15);
   EXPECT_GE(run.frames, 10);
   EXPECT_GE(run.within, 0.95 * run.frames);
   EXPECT_EQ(run.beyond, 0) << "worst " << run.worst;

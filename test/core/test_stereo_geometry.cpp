@@ -404,5 +404,32 @@ TEST(StereoGeometry, TriangulateMidpointRejectsPointsBehindTheCameras) {
   EXPECT_TRUE(matrixNear(converging->point_left, Eigen::Vector3d(0.06, 0, 6), 1e-10));
 }
 
+// A pair's depth scales with the baseline's length (the rays are fixed by the pixels): the
+// triangulation at a 3-sigma longer baseline is the range's `longest` times the current one.
+TEST(BaselineDepthScaleRange, IsTheDepthsRatioOverTheLengthsInterval) {
+  const Eigen::Vector3d baseline(0.0, -0.01, 0.0);  // 1 cm to the right (camera frame y left)
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity() * 1e-6;
+  covariance(1, 1) = 0.1 * 0.1;  // the length's sigma 0.1 m; across it 1 mm
+  const DepthScaleRange range = baselineDepthScaleRange(baseline, covariance, 3.0);
+  EXPECT_NEAR(range.longest, 1.0 + 0.3 / 0.01, 1e-9);
+  EXPECT_EQ(range.shortest, 0.0);  // a length of 0 is within 3 sigma
+  // Triangulated: the same pixels with the baseline 31 times as long, 31 times as deep.
+  StereoRig rig;
+  rig.T_lopt_ropt.translation() = Eigen::Vector3d(0.01, 0, 0);
+  const Eigen::Vector3d left_ray(0.02, 0.01, 1), right_ray(0.0175, 0.01, 1);
+  const auto at_guess = triangulateMidpoint(left_ray, right_ray, rig.T_lopt_ropt);
+  rig.T_lopt_ropt.translation() *= range.longest;
+  const auto at_longest = triangulateMidpoint(left_ray, right_ray, rig.T_lopt_ropt);
+  ASSERT_TRUE(at_guess && at_longest);
+  EXPECT_NEAR(at_longest->point_left.z(), range.longest * at_guess->point_left.z(), 1e-9);
+  // A known length (1 mm on 11 cm): within 3 %.
+  covariance(1, 1) = 1e-6;
+  const DepthScaleRange known =
+      baselineDepthScaleRange(Eigen::Vector3d(0, -0.11, 0), covariance, 3.0);
+  EXPECT_NEAR(known.shortest, 1.0 - 0.003 / 0.11, 1e-9);
+  EXPECT_NEAR(known.longest, 1.0 + 0.003 / 0.11, 1e-9);
+  EXPECT_EQ(baselineDepthScaleRange(Eigen::Vector3d::Zero(), covariance, 3.0).longest, 1.0);
+}
+
 }  // namespace
 }  // namespace osc

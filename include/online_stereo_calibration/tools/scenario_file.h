@@ -37,7 +37,7 @@
 /// moving_point_speed: 2.0              # m/s
 /// trajectory: {tum_file: path, start_offset: 0}   # optional: replaces `motion` (no stops)
 /// rendering: {scene_seed, ground_undulation, structure_density, image_noise, blur_sigma,
-///             supersampling, odom_rate_hz, start_stamp}
+///             supersampling, odom_rate_hz, start_stamp, room_margin, room_height}
 /// ```
 /// Keys left out keep the preset's value. Relative paths are resolved against the scenario
 /// file's directory first, then the current directory. The keys map to the
@@ -67,6 +67,10 @@ struct SceneRenderingOptions {
   int supersampling = 2;            ///< RenderOptions::supersampling (1-4)
   double odom_rate_hz = 100.0;      ///< rate of the simulated INS odometry, > 0
   double start_stamp = 1.7e9;       ///< ROS time (s) of frame 0, >= 1
+  /// > 0: an indoor drive. Four textured walls stand this far (m) beyond the bounding box of
+  /// the path, and no structures are generated (a MAV flying in a room); 0: outdoors.
+  double room_margin = 0.0;
+  double room_height = 4.0;  ///< m, height of the room's walls
 };
 
 /// A recorded trajectory replacing the analytic vehicle motion.

@@ -391,11 +391,22 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   SpatialGrid tracked_grid;
   tracked_grid.build(tracked_pixels, left_mono.cols, left_mono.rows, 32.0);
   const double min_parallax = config_.min_parallax_deg * M_PI / 180.0;
+  // While the filter holds no point, depths over x_camr's baseline length within 3 sigma: a
+  // length guessed far off (1 cm for 11 cm, in a room a few metres wide) must not reject every
+  // pair as too near before the filter and the baseline from motion (which judge them with
+  // x_camr's sigma points) see them. With points held the current length judges alone
+  // (widened always, the window cost image campaign run 10 41 frames beyond 5 sigma).
+  const DepthScaleRange scale =
+      filter.pointCount() > 0
+          ? DepthScaleRange()
+          : baselineDepthScaleRange(filter.extrinsics().T_caml_camr.translation(),
+                                    P.bottomRightCorner<6, 6>().topLeftCorner<3, 3>(), 3.0);
   auto plausible = [&](const Eigen::Vector2d& ul, const Eigen::Vector2d& ur) {
     const auto tri = triangulate(ul, ur);
     if (!tri) return false;
     const double depth = tri->point_left.z();
-    return depth >= filter_config_.min_point_depth && depth <= filter_config_.max_point_depth &&
+    return depth * scale.longest >= filter_config_.min_point_depth &&
+           depth * scale.shortest <= filter_config_.max_point_depth &&
            tri->parallax >= min_parallax;
   };
   std::vector<Eigen::Vector2d> positions, right_positions;

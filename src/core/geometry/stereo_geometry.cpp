@@ -1,5 +1,6 @@
 #include "online_stereo_calibration/core/geometry/stereo_geometry.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "online_stereo_calibration/core/geometry/rotation.h"
@@ -53,6 +54,19 @@ std::optional<Triangulation> triangulateMidpoint(const Eigen::Vector3d& ray_left
   result.parallax = std::acos(std::min(1.0, std::max(-1.0, b)));
   if (!(result.point_left.z() > 0.0)) return std::nullopt;
   return result;
+}
+
+DepthScaleRange baselineDepthScaleRange(const Eigen::Vector3d& baseline,
+                                        const Eigen::Matrix3d& covariance, double sigmas) {
+  DepthScaleRange range;
+  const double length = baseline.norm();
+  if (!(length > 0.0)) return range;
+  const Eigen::Vector3d direction = baseline / length;
+  const double spread =
+      sigmas * std::sqrt(std::max(direction.dot(covariance * direction), 0.0)) / length;
+  range.shortest = std::max(1.0 - spread, 0.0);
+  range.longest = 1.0 + spread;
+  return range;
 }
 
 }  // namespace osc

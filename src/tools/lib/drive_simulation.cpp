@@ -7,7 +7,9 @@
 #include <random>
 
 #include <stdexcept>
+
 #include "online_stereo_calibration/core/sim/odometry_error.h"
+#include "online_stereo_calibration/core/sim/room_walls.h"
 #include "online_stereo_calibration/tools/tum_trajectory.h"
 
 namespace osc {
@@ -73,6 +75,11 @@ DriveSimulator::DriveSimulator(const SimulationScenario& scenario, int frames)
       scene.path.push_back(p);
       last = p;
     }
+  }
+  if (scenario_.rendering.room_margin > 0.0) {  // indoors: walls instead of structures
+    scene.generate_structures = false;
+    scene.extra_primitives = roomWalls(scene.path, scenario_.rendering.room_margin,
+                                       scenario_.rendering.room_height, scene.seed);
   }
   renderer_ = std::make_unique<StereoSceneRenderer>(scene);
 }

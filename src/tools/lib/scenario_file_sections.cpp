@@ -301,7 +301,7 @@ void readRendering(const YAML::Node& node, SceneRenderingOptions* r, Problems* p
   }
   checkKeys(node, "rendering.",
             {"scene_seed", "ground_undulation", "structure_density", "image_noise", "blur_sigma",
-             "supersampling", "odom_rate_hz", "start_stamp"},
+             "supersampling", "odom_rate_hz", "start_stamp", "room_margin", "room_height"},
             p);
   if (node["scene_seed"]) readInt(node["scene_seed"], "rendering.scene_seed", &r->scene_seed, p);
   if (node["supersampling"]) {
@@ -312,7 +312,9 @@ void readRendering(const YAML::Node& node, SceneRenderingOptions* r, Problems* p
                                                     {"image_noise", &r->image_noise},
                                                     {"blur_sigma", &r->blur_sigma},
                                                     {"odom_rate_hz", &r->odom_rate_hz},
-                                                    {"start_stamp", &r->start_stamp}};
+                                                    {"start_stamp", &r->start_stamp},
+                                                    {"room_margin", &r->room_margin},
+                                                    {"room_height", &r->room_height}};
   for (const auto& f : fields) {
     if (node[f.first]) readDouble(node[f.first], std::string("rendering.") + f.first, f.second, p);
   }
@@ -324,6 +326,12 @@ void readRendering(const YAML::Node& node, SceneRenderingOptions* r, Problems* p
     p->add("rendering.supersampling", "must be 1-4");
   if (!(r->odom_rate_hz > 0)) p->add("rendering.odom_rate_hz", "must be > 0");
   if (!(r->start_stamp >= 1)) p->add("rendering.start_stamp", "must be >= 1 s");
+  if (!(r->room_margin >= 0 && r->room_margin <= 100)) {
+    p->add("rendering.room_margin", "must be 0 (outdoors) to 100 m");
+  }
+  if (!(r->room_height > 0 && r->room_height <= 100)) {
+    p->add("rendering.room_height", "must be in (0, 100] m");
+  }
 }
 
 void readTrajectory(const YAML::Node& node, const std::string& base,

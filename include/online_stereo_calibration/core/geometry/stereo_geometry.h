@@ -41,4 +41,17 @@ std::optional<Triangulation> triangulateMidpoint(const Eigen::Vector3d& ray_left
                                                  const Eigen::Vector3d& ray_right,
                                                  const Eigen::Isometry3d& T_lopt_ropt);
 
+/// How far a stereo pair's triangulated depth can be from its value at the current baseline
+/// while the baseline's length is uncertain: with the rays' directions fixed by the pixels,
+/// the depth scales with the length, so over the length's +-`sigmas` interval it lies within
+/// [shortest, longest] times its current value (shortest >= 0).
+struct DepthScaleRange {
+  double shortest = 1.0;
+  double longest = 1.0;
+};
+/// @param baseline the right camera's position in the left camera's frame (m)
+/// @param covariance its 3x3 covariance (m^2)
+DepthScaleRange baselineDepthScaleRange(const Eigen::Vector3d& baseline,
+                                        const Eigen::Matrix3d& covariance, double sigmas);
+
 }  // namespace osc
