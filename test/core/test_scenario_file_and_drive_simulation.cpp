@@ -96,6 +96,9 @@ TEST(ScenarioFileCampaignKeys, ErrorsNameTheKey) {
       {"moving_point_fraction: 2\n", "moving_point_fraction"},
       {"moving_point_speed: fast\n", "moving_point_speed"},
       {"moving_point_speed: -1\n", "moving_point_speed"},
+      {"rendering: {room_margin: -1}\n", "rendering.room_margin"},
+      {"rendering: {room_height: 0}\n", "rendering.room_height"},
+      {"rendering: {room_hight: 3}\n", "rendering.room_hight"},
   };
   for (const auto& c : cases) {
     const std::string error = scenarioError(c.first);

@@ -391,11 +391,9 @@ std::vector<StereoObservation> StereoFrontEnd::observe(const cv::Mat& left_mono,
   SpatialGrid tracked_grid;
   tracked_grid.build(tracked_pixels, left_mono.cols, left_mono.rows, 32.0);
   const double min_parallax = config_.min_parallax_deg * M_PI / 180.0;
-  // While the filter holds no point, depths over x_camr's baseline length within 3 sigma: a
-  // length guessed far off (1 cm for 11 cm, in a room a few metres wide) must not reject every
-  // pair as too near before the filter and the baseline from motion (which judge them with
-  // x_camr's sigma points) see them. With points held the current length judges alone
-  // (widened always, the window cost image campaign run 10 41 frames beyond 5 sigma).
+  // While no point is held, any depth over x_camr's length within 3 sigma: a 1 cm guess for
+  // 11 cm rejected every pair in a room before the filter and the baseline from motion saw it
+  // (widened with points held too, it cost image campaign run 10 41 frames beyond 5 sigma).
   const DepthScaleRange scale =
       filter.pointCount() > 0
           ? DepthScaleRange()
